@@ -1,0 +1,396 @@
+"""pyref: a small reference DEM solver for disks (2D) and spheres (3D) on plane walls.
+
+Newton's law (eq. 1) is integrated by velocity Verlet, the scheme LIGGGHTS uses
+(and whose positions equal YADE's leapfrog): forces at x(t+dt) use v(t+dt/2).
+Contact forces come from pyref/laws.py and nowhere else. Only the effects the
+scene switches on are computed (gravity, rotation, damping, moving walls).
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from .laws import LawParams, normal_force, rotate_history, tangential_force
+
+PAIR_BRUTE_FORCE_MAX = 64  # below this many grains, test every pair (no tree)
+
+
+def _dot(a, b):
+    return np.einsum("ij,ij->i", a, b)
+
+
+class Simulation:
+    def __init__(self, scene, record=True, energy=False):
+        self.scene = scene
+        s = scene
+        self.dim = s.dimension
+        self.dt = s.dt
+        eff = s.effects
+        self.gravity_on = eff["gravity"]
+        self.rotation_on = eff["rotation"]
+        self.moving_walls = eff["moving_walls"]
+        c = s.contact
+        self.p = LawParams(c.law, c.kn, c.nu_n if eff["normal_damping"] else 0.0, c.ks,
+                           c.nu_s if eff["tangential_damping"] else 0.0, c.mu_s, c.mu_k, c.reset)
+
+        g = s.grains
+        self.N = len(g)
+        self.x = np.array([q.position for q in g], float)
+        self.v = np.array([q.velocity for q in g], float)
+        self.w = np.zeros((self.N, 3))
+        self.r = np.array([q.radius for q in g])
+        self.m = np.array([s.grain_mass(q) for q in g])
+        self.inertia = np.array([s.grain_inertia(q) for q in g])
+        self.imposed = np.zeros((self.N, 3), bool)
+        for i, q in enumerate(g):
+            for a in q.imposed:
+                self.imposed[i, "xyz".index(a)] = True
+        self.v_imposed = self.v.copy()
+        self.any_imposed = bool(self.imposed.any())
+        self.g = s.gravity if self.gravity_on else np.zeros(3)
+
+        self.walls = s.walls
+        self.W = len(s.walls)
+        self.wall_n0 = np.array([w.normal for w in s.walls]).reshape(-1, 3)
+        self.wall_p0 = np.array([w.point for w in s.walls]).reshape(-1, 3)
+        self.wall_rot_steps = [s.rotation_steps(w) if w.rotation else 0 for w in s.walls]
+        self.wall_rate = [s.rotation_rate(w) if w.rotation else 0.0 for w in s.walls]
+        self.step_no = 0
+
+        # Contact state, kept sorted by key = i*(N+W) + j, j = grain index or N + wall.
+        self.keys = np.zeros(0, np.int64)
+        self.D = np.zeros((0, 3))
+        self.pairs = None
+        self.x_at_build = None
+        self.skin = 0.2 * float(self.r.min())
+
+        self.energy = energy
+        self.e_diss = 0.0  # energy taken out by the contact laws (dashpots, slips, clipping)
+        self.w_grav = 0.0  # work of gravity
+        self.w_drive = 0.0  # work of imposed velocities and moving walls
+        self.names = {q.name: i for i, q in enumerate(g)}
+        self.names.update({w.name: self.N + k for k, w in enumerate(s.walls)})
+        self.slip_steps = 0
+        self.record = record
+        self._setup_recording()
+        self.f, self.torque = self._forces()
+
+    # ------------------------------------------------------------ walls
+    def _wall_state(self):
+        """Wall points and normals at the current time, and angular rates during the last step."""
+        p, n = self.wall_p0.copy(), self.wall_n0.copy()
+        rates = np.zeros(self.W)
+        for k, w in enumerate(self.walls):
+            if not self.moving_walls:
+                break
+            p[k] = p[k] + w.velocity * self.step_no * self.dt
+            if w.rotation:
+                nrot = self.wall_rot_steps[k]
+                angle = self.wall_rate[k] * self.dt * min(self.step_no, nrot)
+                R = _rotation_matrix(w.rotation.axis, angle)
+                p[k] = w.rotation.pivot + R @ (p[k] - w.rotation.pivot)
+                n[k] = R @ n[k]
+                rates[k] = self.wall_rate[k] if 1 <= self.step_no <= nrot else 0.0
+        return p, n, rates
+
+    def _wall_velocity(self, wk, cp, rates):
+        """Velocity of walls wk at contact points cp during the last step."""
+        vw = np.array([w.velocity for w in self.walls])[wk]
+        for k in np.unique(wk):
+            if rates[k]:
+                rot = self.walls[k].rotation
+                sel = wk == k
+                vw[sel] += rates[k] * np.cross(rot.axis, cp[sel] - rot.pivot)
+        return vw
+
+    def wall_angle(self, k):
+        w = self.walls[k]
+        return self.wall_rate[k] * self.dt * min(self.step_no, self.wall_rot_steps[k]) if w.rotation else 0.0
+
+    # ------------------------------------------------------------ contact detection
+    def _candidate_pairs(self):
+        N = self.N
+        if N < 2:
+            return np.zeros((0, 2), np.int64)
+        if N <= PAIR_BRUTE_FORCE_MAX:
+            if self.pairs is None:
+                self.pairs = np.array(np.triu_indices(N, 1)).T
+            return self.pairs
+        # Verlet list with a skin: rebuilt only when some grain has moved skin/2.
+        if self.x_at_build is not None:
+            moved = np.max(np.sum((self.x - self.x_at_build) ** 2, axis=1))
+            if moved < (0.5 * self.skin) ** 2:
+                return self.pairs
+        from scipy.spatial import cKDTree
+        tree = cKDTree(self.x[:, : self.dim])
+        self.pairs = tree.query_pairs(2 * self.r.max() + self.skin, output_type="ndarray").astype(np.int64)
+        self.x_at_build = self.x.copy()
+        return self.pairs
+
+    def _contacts(self):
+        """All touching grain-grain and grain-wall contacts: i, j, key, n (i -> j), overlap,
+        lever arms and the velocity of j's contact point."""
+        N, W = self.N, self.W
+        ii, jj, nn, dd, vj, rj = [], [], [], [], [], []
+        pairs = self._candidate_pairs()
+        if len(pairs):
+            a, b = pairs[:, 0], pairs[:, 1]
+            d = self.x[b] - self.x[a]
+            dist = np.sqrt(_dot(d, d))
+            delta = self.r[a] + self.r[b] - dist
+            t = delta > 0
+            if t.any():
+                a, b, d, dist, delta = a[t], b[t], d[t], dist[t], delta[t]
+                ii.append(a)
+                jj.append(b)
+                nn.append(d / dist[:, None])
+                dd.append(delta)
+                vj.append(self.v[b])
+                rj.append(self.r[b])
+        if W:
+            p, n, rates = self._wall_state()
+            delta = self.r[:, None] - np.einsum("iwk,wk->iw", self.x[:, None, :] - p[None], n)
+            gi, wk = np.nonzero(delta > 0)
+            if len(gi):
+                dw = delta[gi, wk]
+                ii.append(gi)
+                jj.append(N + wk)
+                nn.append(-n[wk])
+                dd.append(dw)
+                vw = np.zeros((len(gi), 3))
+                if self.moving_walls:
+                    vw = self._wall_velocity(wk, self.x[gi] - (self.r[gi] - dw)[:, None] * n[wk], rates)
+                vj.append(vw)
+                rj.append(np.zeros(len(gi)))
+        if not ii:
+            z = np.zeros(0, np.int64)
+            return z, z, z, np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3)), np.zeros(0)
+        i, j = np.concatenate(ii), np.concatenate(jj)
+        key = i * (N + W) + j
+        return i, j, key, np.concatenate(nn), np.concatenate(dd), np.concatenate(vj), np.concatenate(rj)
+
+    # ------------------------------------------------------------ forces
+    def _forces(self):
+        N = self.N
+        i, j, key, n, delta, v_j, r_j = self._contacts()
+        grain_j = j < N
+        # Relative velocity of i's contact point with respect to j's (docs/law.md step 1).
+        v_rel = self.v[i] - v_j
+        if self.rotation_on:
+            w_j = np.where(grain_j[:, None], self.w[np.minimum(j, N - 1)], 0.0)
+            v_rel = v_rel + np.cross(self.w[i], self.r[i][:, None] * n) + np.cross(w_j, r_j[:, None] * n)
+        v_n = _dot(v_rel, n)
+        V_s = v_rel - v_n[:, None] * n  # eq. 6
+        fn = normal_force(delta, v_n, self.p)  # eq. 3
+
+        # Carry each contact's spring over from the last step; new contacts start at zero,
+        # ended contacts are dropped (their keys are simply not carried).
+        D = np.zeros((len(key), 3))
+        if self.p.has_spring and len(self.keys) and len(key):
+            pos = np.searchsorted(self.keys, key)
+            pos = np.minimum(pos, len(self.keys) - 1)
+            old = self.keys[pos] == key
+            D[old] = rotate_history(self.D[pos[old]], n[old])
+        D_prev = D
+        F_s, D, slipped = tangential_force(D, V_s, fn, self.dt, self.p)
+
+        if self.energy and len(key):
+            self._account_contact_energy(fn, delta, v_n, F_s, V_s, D_prev, D)
+
+        order = np.argsort(key, kind="stable")
+        self.keys, self.D = key[order], D[order]
+        self.slip_steps += int(slipped.sum())
+        self.last = (i, j, key, n, fn, F_s, slipped, delta)
+
+        F = -fn[:, None] * n + F_s
+        f = np.zeros((N, 3))
+        for c in range(3):
+            f[:, c] = np.bincount(i, F[:, c], N) - np.bincount(j[grain_j], F[grain_j, c], N)
+        torque = None
+        if self.rotation_on:
+            Ti = np.cross(self.r[i][:, None] * n, F_s)
+            Tj = np.cross(-r_j[grain_j][:, None] * n[grain_j], -F_s[grain_j])
+            torque = np.zeros((N, 3))
+            for c in range(3):
+                torque[:, c] = np.bincount(i, Ti[:, c], N) + np.bincount(j[grain_j], Tj[:, c], N)
+        if self.gravity_on:
+            f += self.m[:, None] * self.g
+        return f, torque
+
+    def _account_contact_energy(self, fn, delta, v_n, F_s, V_s, D_prev, D):
+        """Energy each contact took out this step. Normal: the non-elastic part of the
+        force times the approach, (Fn - Kn*delta)*v_n*dt. Tangential: work received,
+        -F_s.V_s*dt, minus the increase of the spring's energy 1/2 Ks |D|^2."""
+        dt = self.dt
+        e_n = (fn - self.p.kn * delta) * v_n * dt
+        e_t = -_dot(F_s, V_s) * dt
+        if self.p.has_spring:
+            e_t = e_t - 0.5 * self.p.ks * (_dot(D, D) - _dot(D_prev, D_prev))
+        self.last_e_t = e_t
+        self.e_diss += float(e_n.sum() + e_t.sum())
+
+    # ------------------------------------------------------------ integration
+    def step(self):
+        dt = self.dt
+        a = self.f / self.m[:, None]
+        v_half = self.v + 0.5 * dt * a
+        if self.any_imposed:
+            v_half = np.where(self.imposed, self.v_imposed, v_half)
+        x_old = self.x
+        self.x = self.x + dt * v_half
+        if self.dim == 2:
+            self.x[:, 2] = 0.0
+            v_half[:, 2] = 0.0
+        if self.rotation_on:
+            w_half = self.w + 0.5 * dt * self.torque / self.inertia[:, None]
+            if self.dim == 2:
+                w_half[:, :2] = 0.0
+        f_old = self.f
+        self.v = v_half
+        if self.rotation_on:
+            self.w = w_half
+        self.step_no += 1
+        self.f, self.torque = self._forces()
+        self.v = v_half + 0.5 * dt * self.f / self.m[:, None]
+        if self.any_imposed:
+            self.v = np.where(self.imposed, self.v_imposed, self.v)
+        if self.dim == 2:
+            self.v[:, 2] = 0.0
+        if self.rotation_on:
+            self.w = w_half + 0.5 * dt * self.torque / self.inertia[:, None]
+            if self.dim == 2:
+                self.w[:, :2] = 0.0
+        if self.energy:
+            dx = self.x - x_old
+            if self.gravity_on:
+                self.w_grav += float(np.sum(self.m[:, None] * self.g * dx))
+            if self.any_imposed:
+                # The drive supplies whatever force keeps the imposed components fixed:
+                # minus the other forces on them (trapezoid over the step).
+                fc = -0.5 * (f_old + self.f)
+                self.w_drive += float(np.sum(np.where(self.imposed, fc * dx, 0.0)))
+            if self.moving_walls and self.W:
+                self._account_wall_work()
+
+    def _account_wall_work(self):
+        """Work of moving walls on the grains: contact force on the grain times the
+        wall's velocity at the contact point, over the step."""
+        i, j, _, n, fn, F_s, _, delta = self.last
+        on_wall = j >= self.N
+        if on_wall.any():
+            _, _, rates = self._wall_state()
+            i, n, delta = i[on_wall], n[on_wall], delta[on_wall]
+            cp = self.x[i] + (self.r[i] - delta)[:, None] * n
+            vw = self._wall_velocity(j[on_wall] - self.N, cp, rates)
+            F = -fn[on_wall, None] * n + F_s[on_wall]
+            self.w_drive += float(np.sum(F * vw) * self.dt)
+
+    # ------------------------------------------------------------ energies
+    def kinetic_energy(self):
+        e = 0.5 * float(np.sum(self.m * _dot(self.v, self.v)))
+        if self.rotation_on:
+            e += 0.5 * float(np.sum(self.inertia * _dot(self.w, self.w)))
+        return e
+
+    def elastic_energy(self):
+        i, j, key, n, fn, F_s, slipped, delta = self.last
+        e = 0.5 * self.p.kn * float(np.sum(delta**2))
+        if self.p.has_spring:
+            e += 0.5 * self.p.ks * float(np.sum(self.D * self.D))
+        return e
+
+    # ------------------------------------------------------------ recording
+    def _setup_recording(self):
+        out = self.scene.output
+        self.rec_grains = [self.names[g] for g in out.grains]
+        NW = self.N + self.W
+        self.rec_contacts = [(a, b, "-".join(p)) for p in out.contacts
+                             for a, b in [(self.names[p[0]], self.names[p[1]])]]
+        # A contact a-b is stored with i < j for grain pairs; remember the sign.
+        self.rec_keys = np.array([min(a, b) * NW + max(a, b) if b < self.N else a * NW + b
+                                  for a, b, _ in self.rec_contacts], np.int64)
+        self.rec_sign = np.array([1.0 if (b >= self.N or a < b) else -1.0 for a, b, _ in self.rec_contacts])
+        self.rec_slips = np.zeros(len(self.rec_contacts), np.int64)
+        self.rows = []
+        self.columns = ["t"]
+        axes = "xyz"[: self.dim]
+        for gi in self.rec_grains:
+            nm = self.scene.grains[gi].name
+            self.columns += [f"{nm}_{a}" for a in axes] + [f"{nm}_v{a}" for a in axes]
+            if self.rotation_on:
+                self.columns += [f"{nm}_wz"] if self.dim == 2 else [f"{nm}_w{a}" for a in axes]
+        for _, _, c in self.rec_contacts:
+            self.columns += [f"{c}_fn", f"{c}_fs"] + [f"{c}_ft{a}" for a in axes] + [f"{c}_slip"]
+        self.rec_walls = [k for k, w in enumerate(self.walls) if w.name in self.scene.output.walls]
+        self.columns += [f"{self.walls[k].name}_angle" for k in self.rec_walls]
+        if self.scene.output.stats:
+            self.columns += ["n_contacts", "ekin"]
+        if self.energy:
+            self.columns += ["e_kin", "e_elastic", "e_dissipated", "w_gravity", "w_drive"]
+
+    def _count_slips(self):
+        if not len(self.rec_keys):
+            return
+        key, slipped = self.last[2], self.last[6]
+        if not len(key):
+            return
+        order = np.argsort(key)
+        pos = np.minimum(np.searchsorted(key[order], self.rec_keys), len(key) - 1)
+        hit = key[order][pos] == self.rec_keys
+        self.rec_slips[hit] += slipped[order][pos[hit]]
+
+    def _row(self):
+        t = self.step_no * self.dt
+        row = [t]
+        d = self.dim
+        for gi in self.rec_grains:
+            row += list(self.x[gi, :d]) + list(self.v[gi, :d])
+            if self.rotation_on:
+                row += [self.w[gi, 2]] if d == 2 else list(self.w[gi])
+        i, j, key, n, fn, F_s, slipped, delta = self.last
+        lookup = {int(k): idx for idx, k in enumerate(key)} if len(self.rec_keys) else {}
+        for c, k in enumerate(self.rec_keys):
+            idx = lookup.get(int(k))
+            if idx is None:
+                row += [0.0, 0.0] + [0.0] * d + [int(self.rec_slips[c])]
+            else:
+                ft = F_s[idx] * self.rec_sign[c]
+                row += [fn[idx], float(np.linalg.norm(ft))] + list(ft[:d]) + [int(self.rec_slips[c])]
+        self.rec_slips[:] = 0
+        row += [self.wall_angle(k) for k in self.rec_walls]
+        if self.scene.output.stats:
+            row += [len(key), self.kinetic_energy()]
+        if self.energy:
+            row += [self.kinetic_energy(), self.elastic_energy(), self.e_diss, self.w_grav, self.w_drive]
+        self.rows.append(row)
+
+    # ------------------------------------------------------------ driver
+    def run(self, steps=None, progress=None):
+        """Run the scene; returns (columns, rows, steps, wall_time_s)."""
+        steps = self.scene.steps if steps is None else steps
+        every = self.scene.output.every
+        t0 = time.perf_counter()
+        if self.record:
+            self._row()
+        for k in range(steps):
+            self.step()
+            if self.record:
+                self._count_slips()
+                if self.step_no % every == 0:
+                    self._row()
+            if progress is not None and k % 2000 == 0:
+                progress(k, steps)
+            if not np.isfinite(self.x).all():
+                raise FloatingPointError(f"non-finite position at step {self.step_no} (t = {self.step_no * self.dt:g} s)")
+        if progress is not None:
+            progress(steps, steps)
+        return self.columns, self.rows, steps, time.perf_counter() - t0
+
+
+def _rotation_matrix(axis, angle):
+    """Rodrigues' formula: rotation by `angle` about unit `axis`."""
+    k = np.asarray(axis, float)
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K

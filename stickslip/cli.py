@@ -1,0 +1,114 @@
+"""The `stickslip` command: run a scene on an engine, or build the report."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from . import scene as scene_mod
+from .adapters import ENGINES
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse, but a bad argument is one line on stderr and exit status 2."""
+
+    def error(self, message):
+        sys.stderr.write(f"stickslip: error: {message}\n")
+        sys.exit(2)
+
+
+def _positive(text):
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not v > 0:
+        raise argparse.ArgumentTypeError(f"{text!r} must be > 0")
+    return v
+
+
+def build_parser():
+    p = _Parser(prog="stickslip", description="Stick-slip friction (Khellaf & Mansouri 2024) on DEM engines.")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    r = sub.add_parser("run", help="run one scene on one engine")
+    r.add_argument("scene", help="a case name in cases/ (drag, tray, tilt, ...) or a path to a .toml scene")
+    r.add_argument("--engine", default="pyref", choices=ENGINES)
+    r.add_argument("--dt", type=_positive, help="time step, s (default: the scene's)")
+    r.add_argument("--duration", type=_positive, help="simulated time, s (default: the scene's)")
+    r.add_argument("--law", choices=scene_mod.LAWS, help="tangential law (default: the scene's)")
+    r.add_argument("--reset", choices=scene_mod.RESETS, help="spring reset rule at a slip (default: the scene's)")
+    r.add_argument("--out", type=Path, help="output folder (default: runs/SCENE/ENGINE)")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    rep = sub.add_parser("report", help="run the paper's cases on every available engine; figures + report.md")
+    rep.add_argument("--out", type=Path, default=Path("report"), help="output folder (default: report)")
+    rep.add_argument("--engines", nargs="+", choices=ENGINES, help="engines to use (default: every available one)")
+    rep.add_argument("--quiet", action="store_true", help="no progress bars")
+    return p
+
+
+def main(argv=None):
+    args = build_parser().parse_args(argv)
+    try:
+        if args.command == "run":
+            return cmd_run(args)
+        if args.command == "report":
+            from .report import build_report
+            return build_report(args.out, args.engines, progress=not args.quiet)
+    except scene_mod.SceneError as e:
+        sys.stderr.write(f"stickslip: error: {e}\n")
+        return 2
+    except EngineError as e:
+        sys.stderr.write(f"stickslip: error: {e}\n")
+        return 1
+    return 0
+
+
+class EngineError(RuntimeError):
+    """An engine that is not available or failed; the message says why."""
+
+
+def run_scene(scene, engine, out_dir: Path, progress=True, energy=False):
+    """Run a validated scene on an engine; write timeseries.csv and summary.json."""
+    from . import adapters, analysis
+    from .progress import bar
+
+    adapter = adapters.get(engine)
+    reason = adapter.available()
+    if reason is not None:
+        raise EngineError(f"engine {engine} is not available: {reason}")
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with bar(f"{scene.name} [{engine}, {scene.contact.law}]", scene.steps, enabled=progress) as update:
+        kwargs = {"energy": True} if energy and engine == "pyref" else {}
+        result = adapter.run(scene, out_dir, update, **kwargs)
+    result.timeseries.to_csv(out_dir / "timeseries.csv", index=False)
+    summary = {
+        "scene": scene.name, "engine": engine, "law": scene.contact.law, "reset": scene.contact.reset,
+        "dt_s": scene.dt, "steps": int(result.steps), "wall_time_s": float(result.wall_time_s),
+        "dimension": scene.dimension, "effects": scene.effects,
+    }
+    summary.update(analysis.summarise(scene, result.timeseries))
+    notes = list(result.notes) + analysis.warnings(scene, summary)
+    summary["notes"] = notes
+    (out_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+    for note in notes:
+        sys.stderr.write(f"stickslip: warning: {note}\n")
+    return summary, result.timeseries
+
+
+def cmd_run(args):
+    overrides = {k: getattr(args, k) for k in ("dt", "duration", "law", "reset") if getattr(args, k) is not None}
+    sc = scene_mod.load(args.scene, **overrides)
+    out = args.out or Path("runs") / sc.name / args.engine
+    summary, _ = run_scene(sc, args.engine, out, progress=not args.quiet)
+    shown = {k: v for k, v in summary.items() if k not in ("effects", "notes")}
+    print(json.dumps(shown, indent=2))
+    print(f"wrote {out / 'timeseries.csv'} and {out / 'summary.json'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
