@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# The two commands of the README, on a fresh Debian 12 machine:
+#   ./run.sh report   set up, then run every paper case on every engine -> report/report.md
+#   ./run.sh test     set up, then run the test suite
+# Setup: Debian packages (when root; otherwise it says what to install), a Python
+# virtual environment in .venv with the project installed, and the LIGGGHTS plugin.
+set -euo pipefail
+cd "$(dirname "$0")"
+
+APT_PACKAGES="python3-venv python3-pip liggghts libliggghts-dev libopenmpi-dev openmpi-bin g++ cmake yade python3-numpy"
+
+setup_system() {
+    local missing=()
+    for p in $APT_PACKAGES; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || missing+=("$p")
+    done
+    [ ${#missing[@]} -eq 0 ] && return 0
+    if [ "$(id -u)" -eq 0 ]; then
+        echo "setup: installing Debian packages: ${missing[*]}"
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+    else
+        echo "setup: not root; please run: sudo apt-get install ${missing[*]}" >&2
+        echo "setup: continuing; engines whose packages are missing will be skipped" >&2
+    fi
+}
+
+setup_python() {
+    if [ ! -x .venv/bin/python ]; then
+        python3 -m venv .venv
+    fi
+    .venv/bin/python -m pip install -q --upgrade pip >/dev/null
+    .venv/bin/python -m pip install -q -e '.[test]'
+}
+
+setup_plugin() {
+    # The LIGGGHTS plugin builds in seconds against the installed headers.
+    if [ -f liggghts_plugin/CMakeLists.txt ] && command -v liggghts >/dev/null 2>&1; then
+        cmake -S liggghts_plugin -B build/liggghts_plugin -DCMAKE_BUILD_TYPE=Release >/dev/null
+        cmake --build build/liggghts_plugin -j 2 >/dev/null
+    fi
+}
+
+setup() {
+    setup_system
+    setup_python
+    setup_plugin
+}
+
+case "${1:-}" in
+    report)
+        setup
+        shift
+        .venv/bin/stickslip report "$@"
+        ;;
+    test)
+        setup
+        shift
+        .venv/bin/python -m pytest -q "$@"
+        ;;
+    setup)
+        setup
+        ;;
+    *)
+        echo "usage: ./run.sh report|test|setup [extra arguments]" >&2
+        exit 2
+        ;;
+esac
