@@ -75,16 +75,17 @@ class Simulation:
         self.slip_steps = 0
         self.record = record
         self._setup_recording()
-        self.f, self.torque = self._forces()
+        # Setup forces: no time has passed, so no spring increment (as LIGGGHTS' setup).
+        self.f, self.torque = self._forces(elapsed=0.0)
 
     # ------------------------------------------------------------ walls
     def _wall_state(self):
         """Wall points and normals at the current time, and angular rates during the last step."""
+        if not self.moving_walls:
+            return self.wall_p0, self.wall_n0, np.zeros(self.W)
         p, n = self.wall_p0.copy(), self.wall_n0.copy()
         rates = np.zeros(self.W)
         for k, w in enumerate(self.walls):
-            if not self.moving_walls:
-                break
             p[k] = p[k] + w.velocity * self.step_no * self.dt
             if w.rotation:
                 nrot = self.wall_rot_steps[k]
@@ -151,7 +152,7 @@ class Simulation:
                 rj.append(self.r[b])
         if W:
             p, n, rates = self._wall_state()
-            delta = self.r[:, None] - np.einsum("iwk,wk->iw", self.x[:, None, :] - p[None], n)
+            delta = self.r[:, None] - (self.x @ n.T - np.sum(p * n, axis=1))
             gi, wk = np.nonzero(delta > 0)
             if len(gi):
                 dw = delta[gi, wk]
@@ -172,7 +173,10 @@ class Simulation:
         return i, j, key, np.concatenate(nn), np.concatenate(dd), np.concatenate(vj), np.concatenate(rj)
 
     # ------------------------------------------------------------ forces
-    def _forces(self):
+    def _forces(self, elapsed=None):
+        """Contact (+ gravity) forces and torques at the current state; `elapsed` is the
+        time over which the springs are loaded (one step, or 0 at setup)."""
+        dt = self.dt if elapsed is None else elapsed
         N = self.N
         i, j, key, n, delta, v_j, r_j = self._contacts()
         grain_j = j < N
@@ -187,43 +191,45 @@ class Simulation:
 
         # Carry each contact's spring over from the last step; new contacts start at zero,
         # ended contacts are dropped (their keys are simply not carried).
-        D = np.zeros((len(key), 3))
-        if self.p.has_spring and len(self.keys) and len(key):
-            pos = np.searchsorted(self.keys, key)
-            pos = np.minimum(pos, len(self.keys) - 1)
-            old = self.keys[pos] == key
-            D[old] = rotate_history(self.D[pos[old]], n[old])
+        if not self.p.has_spring:
+            D = np.zeros((len(key), 3))
+        elif len(key) == len(self.keys) and np.array_equal(key, self.keys):
+            D = rotate_history(self.D, n)  # same contacts as last step (the usual case)
+        else:
+            D = np.zeros((len(key), 3))
+            if len(self.keys) and len(key):
+                order = np.argsort(self.keys)
+                sorted_keys = self.keys[order]
+                pos = np.minimum(np.searchsorted(sorted_keys, key), len(sorted_keys) - 1)
+                old = sorted_keys[pos] == key
+                D[old] = rotate_history(self.D[order[pos[old]]], n[old])
         D_prev = D
-        F_s, D, slipped = tangential_force(D, V_s, fn, self.dt, self.p)
+        F_s, D, slipped = tangential_force(D, V_s, fn, dt, self.p)
 
         if self.energy and len(key):
-            self._account_contact_energy(fn, delta, v_n, F_s, V_s, D_prev, D)
+            self._account_contact_energy(fn, delta, v_n, F_s, V_s, D_prev, D, dt)
 
-        order = np.argsort(key, kind="stable")
-        self.keys, self.D = key[order], D[order]
+        self.keys, self.D = key, D
         self.slip_steps += int(slipped.sum())
         self.last = (i, j, key, n, fn, F_s, slipped, delta)
 
         F = -fn[:, None] * n + F_s
-        f = np.zeros((N, 3))
-        for c in range(3):
-            f[:, c] = np.bincount(i, F[:, c], N) - np.bincount(j[grain_j], F[grain_j, c], N)
+        f = _scatter(i, F, N)
+        if grain_j.any():
+            f -= _scatter(j[grain_j], F[grain_j], N)
         torque = None
         if self.rotation_on:
             Ti = np.cross(self.r[i][:, None] * n, F_s)
             Tj = np.cross(-r_j[grain_j][:, None] * n[grain_j], -F_s[grain_j])
-            torque = np.zeros((N, 3))
-            for c in range(3):
-                torque[:, c] = np.bincount(i, Ti[:, c], N) + np.bincount(j[grain_j], Tj[:, c], N)
+            torque = _scatter(i, Ti, N) + _scatter(j[grain_j], Tj, N)
         if self.gravity_on:
             f += self.m[:, None] * self.g
         return f, torque
 
-    def _account_contact_energy(self, fn, delta, v_n, F_s, V_s, D_prev, D):
+    def _account_contact_energy(self, fn, delta, v_n, F_s, V_s, D_prev, D, dt):
         """Energy each contact took out this step. Normal: the non-elastic part of the
         force times the approach, (Fn - Kn*delta)*v_n*dt. Tangential: work received,
         -F_s.V_s*dt, minus the increase of the spring's energy 1/2 Ks |D|^2."""
-        dt = self.dt
         e_n = (fn - self.p.kn * delta) * v_n * dt
         e_t = -_dot(F_s, V_s) * dt
         if self.p.has_spring:
@@ -334,7 +340,7 @@ class Simulation:
         if not len(self.rec_keys):
             return
         key, slipped = self.last[2], self.last[6]
-        if not len(key):
+        if not slipped.any():
             return
         order = np.argsort(key)
         pos = np.minimum(np.searchsorted(key[order], self.rec_keys), len(key) - 1)
@@ -387,6 +393,13 @@ class Simulation:
         if progress is not None:
             progress(steps, steps)
         return self.columns, self.rows, steps, time.perf_counter() - t0
+
+
+def _scatter(idx, values, n):
+    """Sum the rows of `values` (K, 3) into n rows by index (np.add.at, but faster)."""
+    flat = (idx[:, None] * 3 + np.arange(3)).ravel()
+    # (with no contacts bincount returns integers: keep the sum in floating point)
+    return np.bincount(flat, values.ravel(), 3 * n).reshape(n, 3).astype(float, copy=False)
 
 
 def _rotation_matrix(axis, angle):

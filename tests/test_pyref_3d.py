@@ -183,8 +183,8 @@ normal = [0.0, 0.0, 1.0]
     a, b = Simulation(sc, record=False), Simulation(_rotated(sc, Q), record=False)
     a.w[0] = [0.0, 50.0, 20.0]  # spin, so rotation and torques take part
     b.w[0] = Q @ a.w[0]
-    a.f, a.torque = a._forces()
-    b.f, b.torque = b._forces()
+    a.f, a.torque = a._forces(elapsed=0.0)
+    b.f, b.torque = b._forces(elapsed=0.0)
     slips = 0
     for _ in range(sc.steps):
         a.step()
