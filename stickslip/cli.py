@@ -42,10 +42,22 @@ def build_parser():
     r.add_argument("--out", type=Path, help="output folder (default: runs/SCENE/ENGINE)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
 
+    pr = sub.add_parser("precision", help="error vs wall time over a ladder of time steps")
+    pr.add_argument("scene", help="a case name or a scene path")
+    pr.add_argument("--engine", nargs="+", default=["pyref"], choices=ENGINES, dest="engines")
+    pr.add_argument("--factors", nargs="+", type=_positive,
+                    help="dt multipliers (default: 8 4 2 1 0.5 0.25)")
+    pr.add_argument("--out", type=Path, help="output folder (default: precision/SCENE)")
+    pr.add_argument("--quiet", action="store_true", help="no progress bars")
+
+    th = sub.add_parser("thresholds", help="measure the speed above which every step slips, vs the formula")
+    th.add_argument("--out", type=Path, default=Path("thresholds"), help="output folder (default: thresholds)")
+
     rep = sub.add_parser("report", help="run the paper's cases on every available engine; figures + report.md")
     rep.add_argument("--out", type=Path, default=Path("report"), help="output folder (default: report)")
     rep.add_argument("--engines", nargs="+", choices=ENGINES, help="engines to use (default: every available one)")
     rep.add_argument("--quiet", action="store_true", help="no progress bars")
+    rep.add_argument("--no-precision", action="store_true", help="skip the time-step ladders (issue 5 diagrams)")
     return p
 
 
@@ -54,9 +66,18 @@ def main(argv=None):
     try:
         if args.command == "run":
             return cmd_run(args)
+        if args.command == "precision":
+            return cmd_precision(args)
+        if args.command == "thresholds":
+            from .thresholds import run_thresholds
+            for r in run_thresholds(args.out):
+                print(f"dt={r['dt_s']:.2e} s  nu_s={r['nu_s']:6.2f}  V* measured {r['v_star_measured_mps']:.4e} m/s"
+                      f"  formula {r['v_star_formula_mps']:.4e}  ({r['rel_diff']:+.2%})")
+            print(f"wrote {args.out / 'thresholds.csv'} and {args.out / 'thresholds.png'}")
+            return 0
         if args.command == "report":
             from .report import build_report
-            return build_report(args.out, args.engines, progress=not args.quiet)
+            return build_report(args.out, args.engines, progress=not args.quiet, precision=not args.no_precision)
     except scene_mod.SceneError as e:
         sys.stderr.write(f"stickslip: error: {e}\n")
         return 2
@@ -107,6 +128,20 @@ def cmd_run(args):
     shown = {k: v for k, v in summary.items() if k not in ("effects", "notes")}
     print(json.dumps(shown, indent=2))
     print(f"wrote {out / 'timeseries.csv'} and {out / 'summary.json'}")
+    return 0
+
+
+def cmd_precision(args):
+    from .precision import run_precision
+
+    sc = scene_mod.load(args.scene)  # validate first: a bad scene is a one-line error
+    out = args.out or Path("precision") / sc.name
+    out.mkdir(parents=True, exist_ok=True)
+    csv_path, orders = run_precision(args.scene, args.engines, out, args.factors and tuple(args.factors),
+                                     progress=not args.quiet)
+    for (eng, measure), p in sorted(orders.items()):
+        print(f"{eng:9s} {measure:18s} convergence order {p:.2f}")
+    print(f"wrote {csv_path} and the diagrams in {out}")
     return 0
 
 

@@ -24,7 +24,7 @@ def _label(case, law):
     return case if law is None else f"{case}_{law}"
 
 
-def build_report(out: Path, engines=None, progress=True):
+def build_report(out: Path, engines=None, progress=True, precision=True):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -48,6 +48,8 @@ def build_report(out: Path, engines=None, progress=True):
                 skipped[eng] = f"failed on {_label(case, law)}: {e}"
     figs = _figures(out, results, engines)
     text = _markdown(results, engines, skipped, figs)
+    if precision:
+        text += _precision_section(out, engines, progress)
     (out / "report.md").write_text(text)
     print(f"wrote {out / 'report.md'}")
     return 0
@@ -218,6 +220,37 @@ def _markdown(results, engines, skipped, figs):
               "each engine. Summaries in JSON:", ""]
     for (label, eng), (s, _) in sorted(results.items()):
         lines.append(f"- [{label} / {eng}](runs/{label}/{eng}/summary.json)")
+    return "\n".join(lines) + "\n"
+
+
+def _precision_section(out, engines, progress):
+    """What accuracy costs in time (issue 5): dt ladders, and the every-step-slips speed."""
+    from .precision import run_precision
+    from .thresholds import run_thresholds
+
+    lines = ["", "## What accuracy costs in time", "",
+             "Each case over a ladder of time steps on each engine; errors against the finest pyref run "
+             "(the reference). See `stickslip/precision.py` for the error measures.", ""]
+    for case in ("drag", "tray", "tilt"):
+        d = out / "precision" / case
+        d.mkdir(parents=True, exist_ok=True)
+        csv_path, orders = run_precision(case, engines, d, progress=progress)
+        lines += [f"### {case}", "", f"Data: [{csv_path.name}](precision/{case}/{csv_path.name}). Fitted "
+                  "convergence orders: " + ", ".join(f"{e} {m} {p:.2f}" for (e, m), p in sorted(orders.items())), "",
+                  f"![work-precision](precision/{case}/precision_{case}_work.png)",
+                  f"![error vs dt](precision/{case}/precision_{case}_dt.png)", ""]
+        if case == "tilt":
+            lines += ["The tilt velocity at each time step: the stick-slip stretch ends where every step slips, "
+                      "at V* = 2(μs−μk)Fn/(Ks·dt + νs). The dashpot part νs of that limit is physics; the Ks·dt "
+                      "part is a time-step artefact, so the length of the stick-slip stretch and the speed at "
+                      "which steady sliding starts depend on dt, while the steady acceleration (friction Fmin) "
+                      "does not.", "", f"![tilt velocity by dt](precision/{case}/precision_tilt_velocity.png)", ""]
+    rows = run_thresholds(out / "thresholds")
+    worst = max(abs(r["rel_diff"]) for r in rows)
+    lines += ["### Speed above which every step slips", "",
+              f"Measured (bisection, drag case) against V* = 2(μs−μk)Fn/(Ks·dt + νs) for {len(rows)} pairs of "
+              f"dt and νs: largest difference {worst:.2%}. Data: [thresholds.csv](thresholds/thresholds.csv).", "",
+              "![thresholds](thresholds/thresholds.png)", ""]
     return "\n".join(lines) + "\n"
 
 

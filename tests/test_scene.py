@@ -56,10 +56,14 @@ def test_shipped_cases_are_valid():
 
 
 def test_critical_dt_is_the_leapfrog_limit_of_one_contact():
-    # Undamped grain on a wall: w = sqrt(kn/m), limit 2/w.
+    # Undamped grain on a wall: w = sqrt(kn/m), oscillator limit 2/w, impact limit pi/(5 w).
     sc = scene_mod.load("drag", effect_normal_damping=False, effect_tangential_damping=False, kn=1e6, ks=1e5)
     m = sc.grain_mass(sc.grains[0])
-    assert sc.critical_dt() == pytest.approx(2 / (1e6 / m) ** 0.5, rel=1e-12)
+    w = (1e6 / m) ** 0.5
+    limits = scene_mod.stability_limits(sc)
+    assert limits["normal"] == pytest.approx(2 / w, rel=1e-12)
+    assert limits["tangential"] == pytest.approx(2 / (1e5 / m) ** 0.5, rel=1e-12)
+    assert sc.critical_dt() == pytest.approx(3.141592653589793 / w / 5, rel=1e-12)
 
 
 def test_cli_bad_arguments_exit_2_with_one_line(tmp_path):

@@ -1,0 +1,106 @@
+"""The sliding speed above which every step slips, measured against the formula.
+
+After a slip the spring holds Fmin = (2 mu_k - mu_s)Fn (eq. 8); one step later the
+trial force is Fmin + (Ks*dt + nu_s)*V. So every step slips as soon as
+    V >= V* = 2 (mu_s - mu_k) Fn / (Ks*dt + nu_s),
+which contains both limits of the physics notes: the dashpot's (nu_s*V, physical)
+and one step's spring increment (Ks*V*dt, numerical). Above V* the friction sits
+at Fmin instead of averaging mu_k*Fn: the paper's "friction falls with speed"
+(Fig. 15) is partly this time-step artefact.
+"""
+from __future__ import annotations
+
+import copy
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from . import scene as scene_mod
+
+DTS = (1e-6, 4e-6, 1.6e-5)
+NU_S = (0.0, 33.10, 100.0)
+
+
+def formula(sc, dt, nu_s, fn):
+    p = sc.contact
+    return 2 * (p.mu_s - p.mu_k) * fn / (p.ks * dt + nu_s)
+
+
+def every_step_slips(base, dt, nu_s, speed, after_first=40):
+    """Drag at `speed`: does every step after the first slip slip again?"""
+    from pyref import Simulation
+
+    sc = copy.deepcopy(base)
+    sc.dt = dt
+    sc.contact.nu_s = nu_s
+    sc.effects = dict(sc.effects, tangential_damping=nu_s > 0)
+    sc.grains[0].velocity = np.array([speed, 0.0, 0.0])
+    sim = Simulation(sc, record=False)
+    p = sc.contact
+    fn = sim.m[0] * 9.81
+    static = max(0.0, p.mu_s * fn - nu_s * speed) / (p.ks * speed)  # time to the first slip
+    for _ in range(int(static / dt) + 5):
+        sim.step()
+        if sim.slip_steps:
+            break
+    if not sim.slip_steps:
+        raise RuntimeError("no slip where the static phase should have ended")
+    start = sim.slip_steps
+    for _ in range(after_first):
+        sim.step()
+    return sim.slip_steps - start == after_first
+
+
+def measure(base, dt, nu_s, rel_tol=1e-3):
+    """Bisection (in log speed) for the smallest speed at which every step slips."""
+    m = base.grain_mass(base.grains[0])
+    guess = formula(base, dt, nu_s, m * 9.81)
+    lo, hi = guess / 4, guess * 4
+    assert not every_step_slips(base, dt, nu_s, lo) and every_step_slips(base, dt, nu_s, hi)
+    while hi / lo > 1 + rel_tol:
+        mid = (lo * hi) ** 0.5
+        if every_step_slips(base, dt, nu_s, mid):
+            hi = mid
+        else:
+            lo = mid
+    return (lo * hi) ** 0.5, guess
+
+
+def run_thresholds(out: Path, dts=DTS, nus=NU_S):
+    base = scene_mod.load("drag")
+    rows = []
+    for nu in nus:
+        for dt in dts:
+            measured, predicted = measure(base, dt, nu)
+            rows.append({"dt_s": dt, "nu_s": nu, "v_star_measured_mps": measured,
+                         "v_star_formula_mps": predicted, "rel_diff": measured / predicted - 1})
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with open(out / "thresholds.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    _plot(rows, out / "thresholds.png")
+    return rows
+
+
+def _plot(rows, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for nu, mark in zip(sorted({r["nu_s"] for r in rows}), "os^"):
+        rr = [r for r in rows if r["nu_s"] == nu]
+        dts = [r["dt_s"] for r in rr]
+        ax.loglog(dts, [r["v_star_formula_mps"] for r in rr], "-", color="gray")
+        ax.loglog(dts, [r["v_star_measured_mps"] for r in rr], mark, label=f"measured, nu_s = {nu:g} kg/s")
+    ax.set_xlabel("time step dt (s)")
+    ax.set_ylabel("speed above which every step slips (m/s)")
+    ax.set_title("V* = 2(mu_s - mu_k)Fn / (Ks dt + nu_s)  (grey: formula)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
