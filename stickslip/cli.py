@@ -53,6 +53,10 @@ def build_parser():
     th = sub.add_parser("thresholds", help="measure the speed above which every step slips, vs the formula")
     th.add_argument("--out", type=Path, default=Path("thresholds"), help="output folder (default: thresholds)")
 
+    be = sub.add_parser("bench", help="performance figures (pyref, and engines that provide a benchmark)")
+    be.add_argument("--out", type=Path, default=Path("bench"), help="output folder (default: bench)")
+    be.add_argument("--reps", type=int, default=3, help="repetitions per figure (median quoted)")
+
     rep = sub.add_parser("report", help="run the paper's cases on every available engine; figures + report.md")
     rep.add_argument("--out", type=Path, default=Path("report"), help="output folder (default: report)")
     rep.add_argument("--engines", nargs="+", choices=ENGINES, help="engines to use (default: every available one)")
@@ -74,6 +78,10 @@ def main(argv=None):
                 print(f"dt={r['dt_s']:.2e} s  nu_s={r['nu_s']:6.2f}  V* measured {r['v_star_measured_mps']:.4e} m/s"
                       f"  formula {r['v_star_formula_mps']:.4e}  ({r['rel_diff']:+.2%})")
             print(f"wrote {args.out / 'thresholds.csv'} and {args.out / 'thresholds.png'}")
+            return 0
+        if args.command == "bench":
+            from .bench import run_bench
+            run_bench(args.out, reps=max(1, args.reps))
             return 0
         if args.command == "report":
             from .report import build_report

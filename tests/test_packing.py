@@ -1,0 +1,101 @@
+"""A poured packing settling: no NaN, kinetic energy decays, friction never creates
+energy in any contact, and the energy books balance (pyref)."""
+import tomllib
+
+import numpy as np
+import pytest
+
+from stickslip import scene as scene_mod
+from pyref import Simulation
+
+POUR = """
+name = "pour"
+dimension = 2
+gravity = [0.0, -9.81]
+[effects]
+gravity = true
+rotation = true
+normal_damping = true
+tangential_damping = true
+[contact]                  # Table 2
+kn = 1.2e7
+nu_n = 41.38
+ks = 9.6e6
+nu_s = 33.10
+mu_s = 0.5
+mu_k = 0.45
+[time]
+dt = {dt}
+duration = {duration}
+[output]
+every = 200
+stats = true
+[[lattice]]
+origin = [0.003, 0.003]
+counts = [{nx}, {ny}]
+radius = 0.002
+radius_spread = 0.2
+density = 2600
+velocity_jitter = 0.05
+seed = 7
+[[wall]]
+name = "floor"
+point = [0.0, 0.0]
+normal = [0.0, 1.0]
+[[wall]]
+name = "left"
+point = [0.0, 0.0]
+normal = [1.0, 0.0]
+[[wall]]
+name = "right"
+point = [{width}, 0.0]
+normal = [-1.0, 0.0]
+"""
+
+
+def pour(nx, ny, duration, dt=5e-6):
+    width = 0.003 + nx * 2 * 0.002 * 1.2 * 1.05 + 0.001
+    return scene_mod.parse(tomllib.loads(POUR.format(nx=nx, ny=ny, duration=duration, dt=dt, width=width)))
+
+
+def settle(sc):
+    sim = Simulation(sc, record=True, energy=True)
+    worst_e_t = 0.0
+    ekin = []
+    for k in range(sc.steps):
+        sim.step()
+        assert np.isfinite(sim.x).all() and np.isfinite(sim.v).all()
+        e_t = getattr(sim, "last_e_t", None)
+        if e_t is not None and len(e_t):
+            worst_e_t = min(worst_e_t, float(e_t.min()))
+        if k % 200 == 0:
+            ekin.append(sim.kinetic_energy())
+            sim._row()
+    return sim, np.array(ekin), worst_e_t
+
+
+def check(sc, sim, ekin, worst_e_t):
+    # Friction never adds energy: per contact and per step, dissipation >= 0 (round-off).
+    assert worst_e_t >= -1e-15
+    # The pile comes to rest: kinetic energy falls to under 1 % of its peak.
+    assert ekin[-1] < 0.01 * ekin.max()
+    # Energy balance within omega*dt (tests/test_pyref_energy.py explains the bound).
+    import pandas as pd
+
+    df = pd.DataFrame(sim.rows, columns=sim.columns)
+    total = df.e_kin + df.e_elastic + df.e_dissipated - df.w_gravity - df.w_drive
+    scale = max(df.e_dissipated.abs().max(), df.w_gravity.abs().max())
+    assert (total - total.iloc[0]).abs().max() / scale <= 2 * sc.dt / sc.critical_dt()
+    # Nobody leaves the box.
+    assert (sim.x[:, 1] > 0).all()
+
+
+def test_small_pour_settles():
+    sc = pour(12, 10, duration=0.15)  # 120 disks
+    check(sc, *settle(sc))
+
+
+@pytest.mark.slow
+def test_large_pour_settles():
+    sc = pour(50, 60, duration=0.4)  # 3000 disks
+    check(sc, *settle(sc))
