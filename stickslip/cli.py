@@ -112,7 +112,10 @@ def run_scene(scene, engine, out_dir: Path, progress=True, energy=False):
     out_dir.mkdir(parents=True, exist_ok=True)
     with bar(f"{scene.name} [{engine}, {scene.contact.law}]", scene.steps, enabled=progress) as update:
         kwargs = {"energy": True} if energy and engine == "pyref" else {}
-        result = adapter.run(scene, out_dir, update, **kwargs)
+        try:
+            result = adapter.run(scene, out_dir, update, **kwargs)
+        except (RuntimeError, ValueError, OSError) as e:  # the engine's own words, on one line
+            raise EngineError(f"{engine}: {e}") from None
     result.timeseries.to_csv(out_dir / "timeseries.csv", index=False)
     summary = {
         "scene": scene.name, "engine": engine, "law": scene.contact.law, "reset": scene.contact.reset,

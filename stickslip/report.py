@@ -210,7 +210,7 @@ def _markdown(results, engines, skipped, figs):
                   "|---|" + "---|" * len(present)]
         for key, text in claims:
             vals = [_fmt(results[(label, e)][0].get(key)) for e in present]
-            lines.append(f"| {text} | " + " | ".join(vals) + " |")
+            lines.append(f"| {text.replace('|', chr(92) + '|')} | " + " | ".join(vals) + " |")
         notes = [n for e in present for n in results[(label, e)][0].get("notes", [])]
         lines += [""] + [f"> warning: {n}" for n in notes] + [""]
     lines += ["## Figures", ""]

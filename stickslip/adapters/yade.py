@@ -1,0 +1,84 @@
+"""Adapter for YADE (Debian's package): runs yade_law/run_scene.py in `yade -n -x`.
+
+YADE runs on the system Python, so the scene goes over as JSON (with the masses the
+scene defines: in 2D a disk's mass per unit thickness, carried by an equivalent sphere)
+and the time series comes back as CSV.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import RunResult
+
+NAME = "yade"
+RUNNER = Path(__file__).resolve().parents[2] / "yade_law" / "run_scene.py"
+
+
+def available():
+    if shutil.which("yade") is None:
+        return "`yade` not on PATH (apt-get install yade)"
+    if not RUNNER.is_file():
+        return f"{RUNNER} missing"
+    return None
+
+
+def scene_dict(scene):
+    """Everything run_scene.py needs, in plain JSON types."""
+    v = lambda a: [float(x) for x in np.asarray(a)[:3]]  # noqa: E731
+    walls = []
+    for w in scene.walls:
+        d = {"name": w.name, "point": v(w.point), "normal": v(w.normal), "velocity": v(w.velocity)}
+        if w.rotation is not None:
+            d["rotation"] = {"pivot": v(w.rotation.pivot), "axis": v(w.rotation.axis),
+                             "rate": scene.rotation_rate(w), "steps": scene.rotation_steps(w)}
+        walls.append(d)
+    c = scene.contact
+    return {
+        "dimension": scene.dimension, "effects": scene.effects, "gravity": v(scene.gravity),
+        "contact": {"kn": c.kn, "nu_n": c.nu_n, "ks": c.ks, "nu_s": c.nu_s, "mu_s": c.mu_s, "mu_k": c.mu_k,
+                    "reset": c.reset},
+        "dt": scene.dt, "steps": scene.steps, "every": scene.output.every,
+        "grains": [{"name": g.name, "radius": g.radius, "mass": scene.grain_mass(g),
+                    "inertia": scene.grain_inertia(g), "position": v(g.position), "velocity": v(g.velocity),
+                    "imposed": list(g.imposed)} for g in scene.grains],
+        "walls": walls,
+        "output": {"grains": scene.output.grains, "contacts": scene.output.contacts, "walls": scene.output.walls,
+                   "stats": scene.output.stats},
+    }
+
+
+def run(scene, out_dir, progress=None):
+    if scene.contact.law != "stick_slip":
+        raise ValueError(f"the YADE law implements stick_slip only, not {scene.contact.law}")
+    work = Path(out_dir) / "yade"
+    work.mkdir(parents=True, exist_ok=True)
+    (work / "scene.json").write_text(json.dumps(scene_dict(scene), indent=1))
+    csv_path = work / "timeseries_raw.csv"
+    t0 = time.perf_counter()
+    wall = None
+    with open(work / "yade.log", "w") as log:
+        env = dict(os.environ, STICKSLIP_YADE_LAW=str(RUNNER.parent))
+        p = subprocess.Popen(["yade", "-n", "-x", str(RUNNER), str(work / "scene.json"), str(csv_path)],
+                             stdout=subprocess.PIPE, stderr=log, text=True, cwd=work, env=env)
+        for line in p.stdout:
+            log.write(line)
+            if line.startswith("PROGRESS") and progress is not None:
+                done, total = map(int, line.split()[1:3])
+                progress(done, total)
+            elif line.startswith("WALLTIME"):
+                wall = float(line.split()[1])
+            elif line.startswith("ERROR"):
+                raise ValueError(line[6:].strip())
+        p.wait()
+    if p.returncode != 0 or not csv_path.is_file():
+        raise RuntimeError(f"yade failed (exit {p.returncode}); see {work / 'yade.log'}")
+    df = pd.read_csv(csv_path)
+    return RunResult(df, scene.steps, wall if wall is not None else time.perf_counter() - t0)

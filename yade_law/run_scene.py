@@ -1,0 +1,154 @@
+"""Run one stickslip scene in YADE: `yade -n -x run_scene.py scene.json out.csv`.
+
+Knows only YADE and the scene dict written by stickslip/adapters/yade.py (masses are
+already those of the scene: in 2D the disk's mass per unit thickness, carried by an
+"equivalent sphere" moving in the xy-plane). Only the effects the scene switches on
+are put in O.engines. Prints "PROGRESS done total" lines for the adapter.
+"""
+import csv
+import json
+import math
+import os
+import sys
+import time
+
+# Under `yade -x` __file__ is not this script; the adapter puts yade_law/ on PYTHONPATH.
+sys.path.insert(0, os.environ.get("STICKSLIP_YADE_LAW", "."))
+
+from stickslip_yade import stickslip_engines, stickslip_material  # noqa: E402
+from yade import O, Quaternion, RotationEngine, Vector3, utils  # noqa: E402
+
+WALL_HALF_SIZE = 1.0  # m: walls are boxes this wide, ...
+WALL_HALF_THICKNESS = 0.01  # ... and this thick, their face on the scene's plane
+
+
+def quaternion_from_y(normal):
+    """Rotation taking the box's +y face normal onto `normal`."""
+    y = Vector3(0, 1, 0)
+    n = Vector3(*normal)
+    axis = y.cross(n)
+    c = max(-1.0, min(1.0, y.dot(n)))
+    if axis.norm() < 1e-12:
+        return Quaternion(Vector3(1, 0, 0), 0.0 if c > 0 else math.pi)
+    return Quaternion(axis / axis.norm(), math.acos(c))
+
+
+def build(sc):
+    c, eff = sc["contact"], sc["effects"]
+    mat = O.materials.append(stickslip_material(c["kn"], c["nu_n"] if eff["normal_damping"] else 0.0))
+    ids = {}
+    for w in sc["walls"]:  # walls first: they become id1 of their interactions
+        n = Vector3(*w["normal"])
+        center = Vector3(*w["point"]) - n * WALL_HALF_THICKNESS
+        b = utils.box(center=center, extents=(WALL_HALF_SIZE, WALL_HALF_THICKNESS, WALL_HALF_SIZE),
+                      orientation=quaternion_from_y(w["normal"]), fixed=True, material=mat)
+        if eff["moving_walls"]:
+            b.state.vel = Vector3(*w["velocity"])
+        ids[w["name"]] = O.bodies.append(b)
+    for g in sc["grains"]:
+        b = utils.sphere(center=tuple(g["position"]), radius=g["radius"], material=mat)
+        b.state.mass = g["mass"]
+        b.state.inertia = Vector3(g["inertia"], g["inertia"], g["inertia"])
+        blocked = "".join(g["imposed"])
+        if sc["dimension"] == 2:
+            blocked += "zXY"  # motion in the xy-plane, rotation about z only
+        if not eff["rotation"]:
+            blocked += "XYZ" if sc["dimension"] == 3 else "Z"
+        b.state.blockedDOFs = "".join(sorted(set(blocked), key=blocked.index))
+        b.state.vel = Vector3(*g["velocity"])
+        ids[g["name"]] = O.bodies.append(b)
+    rotators = []
+    for w in sc["walls"]:
+        if eff["moving_walls"] and w.get("rotation"):
+            r = w["rotation"]
+            eng = RotationEngine(ids=[ids[w["name"]]], rotationAxis=Vector3(*r["axis"]), angularVelocity=r["rate"],
+                                 rotateAroundZero=True, zeroPoint=Vector3(*r["pivot"]))
+            rotators.append((eng, ids[w["name"]], r["steps"]))
+    O.engines = stickslip_engines(ks=c["ks"], nu_s=c["nu_s"] if eff["tangential_damping"] else 0.0,
+                                  mu_s=c["mu_s"], mu_k=c["mu_k"], reset=c["reset"],
+                                  gravity=sc["gravity"] if eff["gravity"] else (0.0, 0.0, 0.0),
+                                  rotation=eff["rotation"], extra=[e for e, _, _ in rotators])
+    O.dt = sc["dt"]
+    return ids, rotators
+
+
+def main(scene_path, out_path):
+    sc = json.load(open(scene_path))
+    ids, rotators = build(sc)
+    import builtins
+
+    law = builtins.stickslip_law
+    dim, every, steps = sc["dimension"], sc["every"], sc["steps"]
+    axes = "xyz"[:dim]
+    out = sc["output"]
+    header = ["t"]
+    for g in out["grains"]:
+        header += [f"{g}_{a}" for a in axes] + [f"{g}_v{a}" for a in axes]
+        if sc["effects"]["rotation"]:
+            header += [f"{g}_wz"] if dim == 2 else [f"{g}_w{a}" for a in axes]
+    pairs = []
+    for a, b in out["contacts"]:
+        ia, ib = ids[a], ids[b]
+        key, sign = ((ia, ib), 1.0) if ia < ib else ((ib, ia), -1.0)
+        pairs.append((key, sign))
+        header += [f"{a}-{b}_{q}" for q in ("fn", "fs")] + [f"{a}-{b}_ft{x}" for x in axes] + [f"{a}-{b}_slip"]
+    wall_rot = {w["name"]: w["rotation"] for w in sc["walls"] if w.get("rotation")}
+    header += [f"{w}_angle" for w in out["walls"]]
+    if out["stats"]:
+        header += ["n_contacts", "ekin"]
+    slips = [0] * len(pairs)
+
+    def row(step):
+        r = [step * O.dt]
+        for g in out["grains"]:
+            s = O.bodies[ids[g]].state
+            r += [s.pos[k] for k in range(dim)] + [s.vel[k] for k in range(dim)]
+            if sc["effects"]["rotation"]:
+                r += [s.angVel[2]] if dim == 2 else [s.angVel[k] for k in range(3)]
+        for k, (key, sign) in enumerate(pairs):
+            fn, f, _ = law.last.get(key, (0.0, (0.0, 0.0, 0.0), False))
+            ft = [sign * f[q] for q in range(3)]
+            r += [fn, math.sqrt(sum(x * x for x in ft))] + ft[:dim] + [slips[k]]
+            slips[k] = 0
+        for w in out["walls"]:
+            rot = wall_rot.get(w)
+            r += [rot["rate"] * O.dt * min(step, rot["steps"]) if rot else 0.0]
+        if out["stats"]:
+            ek = sum(0.5 * b.state.mass * b.state.vel.squaredNorm() for b in O.bodies if b.dynamic)
+            r += [len(law.last), ek]
+        return r
+
+    rows = [row(0)]
+    stop_at = {n: (eng, bid) for eng, bid, n in rotators}
+    t0 = time.perf_counter()
+    for step in range(1, steps + 1):
+        O.step()
+        if pairs:
+            for k, (key, _) in enumerate(pairs):
+                got = law.last.get(key)
+                if got is not None and got[2]:
+                    slips[k] += 1
+        if step in stop_at:  # the wall has turned to its stop angle: hold it there
+            eng, bid = stop_at[step]
+            eng.dead = True
+            O.bodies[bid].state.vel = Vector3(0, 0, 0)
+            O.bodies[bid].state.angVel = Vector3(0, 0, 0)
+        if step % every == 0:
+            rows.append(row(step))
+        if step % 5000 == 0:
+            print(f"PROGRESS {step} {steps}", flush=True)
+    wall = time.perf_counter() - t0
+    with open(out_path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        w.writerows(rows)
+    print(f"WALLTIME {wall}", flush=True)
+
+
+if __name__ == "__main__":
+    try:
+        main(sys.argv[1], sys.argv[2])
+    except ValueError as e:  # a bad parameter: one line, no traceback
+        print(f"ERROR {e}", flush=True)
+        sys.exit(3)
+    sys.exit(0)
