@@ -183,8 +183,9 @@ class Simulation:
         # Relative velocity of i's contact point with respect to j's (docs/law.md step 1).
         v_rel = self.v[i] - v_j
         if self.rotation_on:
+            # w_i x (r_i n) + w_j x (r_j n) = (r_i w_i + r_j w_j) x n: both lever arms lie along n.
             w_j = np.where(grain_j[:, None], self.w[np.minimum(j, N - 1)], 0.0)
-            v_rel = v_rel + np.cross(self.w[i], self.r[i][:, None] * n) + np.cross(w_j, r_j[:, None] * n)
+            v_rel = v_rel + _cross(self.r[i][:, None] * self.w[i] + r_j[:, None] * w_j, n)
         v_n = _dot(v_rel, n)
         V_s = v_rel - v_n[:, None] * n  # eq. 6
         fn = normal_force(delta, v_n, self.p)  # eq. 3
@@ -214,14 +215,15 @@ class Simulation:
         self.last = (i, j, key, n, fn, F_s, slipped, delta)
 
         F = -fn[:, None] * n + F_s
-        f = _scatter(i, F, N)
-        if grain_j.any():
-            f -= _scatter(j[grain_j], F[grain_j], N)
+        jg = j[grain_j]
+        # Forces on i, and the opposite on grain j (walls take nothing), in one scatter.
+        f = _scatter(np.concatenate((i, jg)), np.concatenate((F, -F[grain_j])), N)
         torque = None
         if self.rotation_on:
-            Ti = np.cross(self.r[i][:, None] * n, F_s)
-            Tj = np.cross(-r_j[grain_j][:, None] * n[grain_j], -F_s[grain_j])
-            torque = _scatter(i, Ti, N) + _scatter(j[grain_j], Tj, N)
+            # Torques (r_i n) x F_s on i and (-r_j n) x (-F_s) = r_j (n x F_s) on j.
+            c = _cross(n, F_s)
+            torque = _scatter(np.concatenate((i, jg)),
+                              np.concatenate((self.r[i][:, None] * c, r_j[grain_j][:, None] * c[grain_j])), N)
         if self.gravity_on:
             f += self.m[:, None] * self.g
         return f, torque
@@ -393,6 +395,13 @@ class Simulation:
         if progress is not None:
             progress(steps, steps)
         return self.columns, self.rows, steps, time.perf_counter() - t0
+
+
+def _cross(a, b):
+    """Row-wise cross product of (K, 3) arrays (np.cross, without its axis juggling)."""
+    return np.stack((a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
+                     a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]), axis=1)
 
 
 def _scatter(idx, values, n):
