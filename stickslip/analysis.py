@@ -61,17 +61,17 @@ def drag(scene, df):
     p = scene.contact
     speed = float(np.linalg.norm(g.velocity))
     fn_mean = float(fn[fn > 0].mean())
+    nu_s = p.nu_s if scene.effects["tangential_damping"] else 0.0
+    drop = 2 * (p.mu_s - p.mu_k) * fn_mean  # the force the spring must regain after a slip
     out = {
         "fs_fn_max": float(ratio.max()),
         "slip_count": int(df[f"{c}_slip"].sum()),
         "fn_mean_N": fn_mean,
         "drag_speed_mps": speed,
-        # Paper's period (section 3.1) and the same with the dashpot's jump nu_s*V at
-        # the start of each stick phase, which shortens the spring's travel.
-        "slip_period_paper_s": 2 * (p.mu_s - p.mu_k) * fn_mean / (p.ks * speed) if speed else None,
-        "slip_period_expected_s": (2 * (p.mu_s - p.mu_k) * fn_mean - p.nu_s * speed) / (p.ks * speed)
-        if speed and scene.effects["tangential_damping"] else
-        (2 * (p.mu_s - p.mu_k) * fn_mean / (p.ks * speed) if speed else None),
+        # Paper's period (section 3.1), and the same less the dashpot's jump nu_s*V at the
+        # start of each stick phase, which shortens the spring's travel.
+        "slip_period_paper_s": drop / (p.ks * speed) if speed else None,
+        "slip_period_expected_s": (drop - nu_s * speed) / (p.ks * speed) if speed else None,
     }
     if len(rows) >= 2:
         # Whole saw-tooth periods: from just after the first slip to the last slip.

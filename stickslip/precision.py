@@ -131,12 +131,12 @@ def _plot_tilt_velocities(runs, out):
 
 
 def formula_v_star(sc, summary):
-    """Speed above which every step slips, V* = 2(mu_s - mu_k)Fn/(Ks dt + nu_s) (thresholds.py)."""
-    p = sc.contact
+    """Speed above which every step slips on the held plate (thresholds.formula)."""
+    from .thresholds import formula
+
     g = next(q for q in sc.grains if q.name == sc.analysis["grain"])
     fn = sc.grain_mass(g) * float(np.linalg.norm(sc.gravity)) / math.sqrt(1 + summary["tan_beta_stop"] ** 2)
-    nu = p.nu_s if sc.effects["tangential_damping"] else 0.0
-    return 2 * (p.mu_s - p.mu_k) * fn / (p.ks * sc.dt + nu)
+    return formula(sc, sc.dt, sc.contact.nu_s if sc.effects["tangential_damping"] else 0.0, fn)
 
 
 def convergence_order(dts, errs):
