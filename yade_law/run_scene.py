@@ -106,7 +106,7 @@ def main(scene_path, out_path):
             if sc["effects"]["rotation"]:
                 r += [s.angVel[2]] if dim == 2 else [s.angVel[k] for k in range(3)]
         for k, (key, sign) in enumerate(pairs):
-            fn, f, _ = law.last.get(key, (0.0, (0.0, 0.0, 0.0), False))
+            fn, f, _ = law.lookup(*key) or (0.0, (0.0, 0.0, 0.0), False)
             ft = [sign * f[q] for q in range(3)]
             r += [fn, math.sqrt(sum(x * x for x in ft))] + ft[:dim] + [slips[k]]
             slips[k] = 0
@@ -115,7 +115,7 @@ def main(scene_path, out_path):
             r += [rot["rate"] * O.dt * min(step, rot["steps"]) if rot else 0.0]
         if out["stats"]:
             ek = sum(0.5 * b.state.mass * b.state.vel.squaredNorm() for b in O.bodies if b.dynamic)
-            r += [len(law.last), ek]
+            r += [len(law.keys), ek]
         return r
 
     rows = [row(0)]
@@ -125,7 +125,7 @@ def main(scene_path, out_path):
         O.step()
         if pairs:
             for k, (key, _) in enumerate(pairs):
-                got = law.last.get(key)
+                got = law.lookup(*key)
                 if got is not None and got[2]:
                     slips[k] += 1
         if step in stop_at:  # the wall has turned to its stop angle: hold it there

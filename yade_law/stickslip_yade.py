@@ -1,24 +1,43 @@
 """The stick-slip friction law of Khellaf & Mansouri (2024) for YADE, in Python.
 
-Use in an ordinary YADE script (see yade_law/README.md):
+Use in an ordinary YADE script (full example: yade_law/example_drag.py, README.md):
 
     import sys; sys.path.insert(0, "/path/to/yade_law")
     from stickslip_yade import stickslip_material, stickslip_engines
     mat = O.materials.append(stickslip_material(kn=1.2e7, nu_n=41.38))
-    ... bodies with material=mat ...
+    ... spheres / boxes / walls with material=mat ...
     O.engines = stickslip_engines(ks=9.6e6, nu_s=33.1, mu_s=0.5, mu_k=0.45, gravity=(0, -9.81, 0))
 
-The native Law2_ScGeom_ViscElPhys_Basic gives the normal force (eq. 3, never tensile);
-a PyRunner placed before NewtonIntegrator adds the tangential force of this law,
-exactly as docs/law.md states it (3D form: the spring elongation D is kept in the
-current tangent plane). YADE does not call Python subclasses of Law2 classes, and
-extra attributes cannot be attached to interactions, so per-contact state lives in a
-dict keyed by (id1, id2) and is renewed when a contact is made again.
+The native Law2_ScGeom_ViscElPhys_Basic applies the normal force (eq. 3, never
+tensile; kn = Kn, cn = nu_n, no native shear force). A PyRunner placed before
+NewtonIntegrator adds the tangential force of docs/law.md (3D form: the spring
+elongation D is kept in the current tangent plane).
+
+Why it is written this way (measured on YADE 2023.02a, see README.md):
+- YADE never calls a Python subclass of a Law2 class, and interactions take no extra
+  attributes, so the per-contact state lives here, keyed by (id1, id2).
+- Every attribute read from YADE costs 0.3-0.7 us, so per-contact reads are cut to
+  id1, id2, iterMadeReal. For sphere-sphere contacts the normal, overlap, relative
+  velocity and normal force are recomputed in numpy from body positions (3 bulk
+  calls) and velocities (one read per body), with the contact's own kn, cn read
+  once when it is made: the same numbers the native law used (check=True compares).
+  Contacts with a non-sphere (box, wall) read normal, contact point and normal
+  force from YADE, one by one (few of them).
+- The law runs vectorised over all contacts; forces and torques are summed per body
+  and added with one O.forces.addF/addT per body.
+- The state is kept as arrays sorted by key, not as a Python dict: a dict lookup per
+  contact would cost about as much as the whole law. Same semantics: a contact's
+  state is dropped the first step it is not real, and a contact made again
+  (different iterMadeReal) starts from D = 0.
+Limits: spheres, boxes and walls; no clumps, no periodic cell, interactionDetectionFactor 1;
+bodies appended during a run are picked up, an erased body's id reused is not.
 """
 from __future__ import annotations
 
 import builtins
+import gc
 import math
+from itertools import chain
 
 import numpy as np
 
@@ -28,7 +47,7 @@ RESETS = ("spring", "total")
 def check_parameters(ks, nu_s, mu_s, mu_k, reset="spring", kn=None, nu_n=None):
     """Raise ValueError naming the parameter and its allowed range (docs/law.md)."""
     def finite(name, v):
-        if not isinstance(v, (int, float)) or not math.isfinite(v):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise ValueError(f"{name} = {v!r}: must be a finite number")
 
     for name, v in (("ks", ks), ("nu_s", nu_s), ("mu_s", mu_s), ("mu_k", mu_k)):
@@ -55,110 +74,267 @@ def check_parameters(ks, nu_s, mu_s, mu_k, reset="spring", kn=None, nu_n=None):
 
 
 def stickslip_material(kn, nu_n=0.0, density=2600.0, label=None):
-    """A ViscElMat whose contacts get kn = Kn and cn = nu_n (Ip2 puts two materials in
-    series, so each side carries twice the value) and no native shear force."""
+    """A ViscElMat whose contacts get kn = Kn and cn = nu_n (Ip2 puts the two materials
+    in series, so each side carries twice the value) and no native shear force."""
     from yade import ViscElMat
 
     check_parameters(1.0, 0.0, 1.0, 1.0, kn=kn, nu_n=nu_n)
+    if not density > 0:
+        raise ValueError(f"density = {density!r}: must be > 0")
     mat = ViscElMat(kn=2.0 * kn, cn=2.0 * nu_n, ks=0.0, cs=0.0, frictionAngle=0.0, density=density)
     if label:
         mat.label = label
     return mat
 
 
-class StickSlipLaw:
-    """The tangential law for all interactions; call `step()` once per time step."""
+def _dot(a, b):
+    return np.einsum("ij,ij->i", a, b)
 
-    def __init__(self, ks, nu_s, mu_s, mu_k, reset="spring", lever_arms=False):
+
+def _rows(vectors):
+    """Vector3s -> (n, 3) array. __getinitargs__() gives the three components in one
+    call (0.3 us); v[0], v[1], v[2] costs 0.7 us and tuple(v) over 10 us."""
+    t = [v.__getinitargs__() for v in vectors]
+    return np.fromiter(chain.from_iterable(t), float, 3 * len(t)).reshape(-1, 3)  # 3x faster than np.array(t)
+
+
+class StickSlipLaw:
+    """The tangential law for all real interactions; `step()` runs once per time step.
+
+    After a step, `contact(id1, id2)` gives (Fn, F_s on id1 as (3,) array, slipped
+    this step, slip steps since the contact was made) or None if not touching.
+    """
+
+    def __init__(self, ks, nu_s, mu_s, mu_k, reset="spring", rotation=True, check=False):
         check_parameters(ks, nu_s, mu_s, mu_k, reset)
         self.ks, self.nu_s, self.mu_s, self.mu_k, self.reset = ks, nu_s, mu_s, mu_k, reset
-        self.lever_arms = lever_arms  # torques only when rotation is simulated
-        self.state = {}  # (id1, id2) -> [D (3,), iterMadeReal, slip count]
-        self.last = {}  # (id1, id2) -> (fn, F_s on id1, slipped) of the last step
+        self.rotation = rotation  # torques (and grain spin in V_s) only when rotation is simulated
+        self.check = check  # compare recomputed normals / normal forces with YADE's (tests, bench)
+        self.max_fn_error = 0.0  # largest |Fn - native Fn| / max(native Fn) seen with check=True
+        self.checked = 0  # sphere-sphere contact-steps compared with check=True
+        self.nbodies = -1
+        self._clear()
+
+    def _clear(self):
+        z = np.zeros(0)
+        self.keys, self.made = np.zeros(0, np.int64), np.zeros(0, np.int64)
+        self.D, self.F_s = np.zeros((0, 3)), np.zeros((0, 3))
+        self.kn, self.cn, self.fn = z, z, z
+        self.slipped, self.count = np.zeros(0, bool), np.zeros(0, np.int64)
+
+    def _refresh_bodies(self, O):
+        """Per-body data that does not change during a run (redone when the body count
+        changes): states, which bodies are spheres, radii, and whether ids are dense so
+        that the bulk position reader lines up with ids."""
+        from yade import Sphere
+
+        bodies = list(O.bodies)
+        n = len(O.bodies)
+        self.states = [None] * n
+        self.sphere = np.zeros(n, bool)
+        self.radius = np.zeros(n)
+        for b in bodies:
+            if b is None:
+                continue
+            self.states[b.id] = b.state
+            if isinstance(b.shape, Sphere):
+                self.sphere[b.id], self.radius[b.id] = True, b.shape.radius
+        self.dense = all(s is not None for s in self.states)
+        self.nbodies = n
+
+    def _positions(self, used):
+        import yade._utils as yu
+
+        if self.dense:  # all bodies in id order, three C++ calls
+            P = np.array([yu.coordsAndDisplacements(a)[0] for a in range(3)]).T
+            if len(P) == self.nbodies:
+                return P
+        P = np.zeros((self.nbodies, 3))
+        P[used] = _rows([self.states[i].pos for i in used.tolist()])
+        return P
 
     def step(self):
-        from yade import O, Vector3
+        # The step creates some 10^5 short-lived Python objects; the cyclic garbage
+        # collector, triggered by them, would scan them all (about 1 us per contact).
+        enabled = gc.isenabled()
+        gc.disable()
+        try:
+            self._step()
+        finally:
+            if enabled:
+                gc.enable()
 
-        dt = O.dt
-        keys, rows, refs = [], [], []
-        for I in O.interactions:  # real (touching) interactions only
-            g = I.geom
-            n, s = g.normal, g.shearInc
-            keys.append((I.id1, I.id2, I.iterMadeReal))
-            rows.append((n[0], n[1], n[2], s[0], s[1], s[2], I.phys.normalForce.norm()))
-            if self.lever_arms:
-                refs.append((g.refR1, g.refR2))
-        if not keys:
-            self.state, self.last = {}, {}
+    def _step(self):
+        from yade import O
+
+        if len(O.bodies) != self.nbodies:
+            self._refresh_bodies(O)
+        L = list(O.interactions)  # real (touching) interactions only
+        m = len(L)
+        if m == 0:
+            self._clear()
             return
-        a = np.array(rows)
-        n, fn = a[:, 0:3], a[:, 6]
-        # shearInc is id2's tangential displacement relative to id1 this step; the law is
-        # written for i = id1, whose relative velocity is the opposite (eq. 6).
-        V_s = -a[:, 3:6] / dt
-        D = np.zeros((len(keys), 3))
-        state = {}
-        for k, (i1, i2, made) in enumerate(keys):
-            old = self.state.get((i1, i2))
-            if old is not None and old[1] == made:
-                D[k] = old[0]
-        # Turn the spring into the current tangent plane, keeping its length (3D form).
-        dn = np.einsum("ij,ij->i", D, n)
+        i1 = np.fromiter([I.id1 for I in L], np.int64, m)
+        i2 = np.fromiter([I.id2 for I in L], np.int64, m)
+        made = np.fromiter([I.iterMadeReal for I in L], np.int64, m)
+        key = (i1 << 32) | i2
+        dt, nb = O.dt, self.nbodies
+
+        # Carry each contact's state from the last step; new or re-made contacts start fresh.
+        D = np.zeros((m, 3))
+        kn, cn, count = np.zeros(m), np.zeros(m), np.zeros(m, np.int64)
+        old = np.zeros(m, bool)
+        if len(self.keys):
+            p = np.minimum(np.searchsorted(self.keys, key), len(self.keys) - 1)
+            old = (self.keys[p] == key) & (self.made[p] == made)
+            po = p[old]
+            D[old], kn[old], cn[old], count[old] = self.D[po], self.kn[po], self.cn[po], self.count[po]
+
+        ss = self.sphere[i1] & self.sphere[i2]  # sphere-sphere: geometry recomputed here
+        for k in np.flatnonzero(~old & ss).tolist():  # new contacts: their own kn, cn once
+            ph = L[k].phys
+            kn[k], cn[k] = ph.kn, ph.cn
+
+        # Body kinematics at this step: x(t), v(t - dt/2), as the native law saw them.
+        used = np.zeros(nb, bool)
+        used[i1] = used[i2] = True
+        used = np.flatnonzero(used)
+        P = self._positions(used)
+        V, W = np.zeros((nb, 3)), np.zeros((nb, 3))
+        st = self.states
+        V[used] = _rows([st[i].vel for i in used.tolist()])
+        spin = used if self.rotation else used[~self.sphere[used]]  # walls may turn anyway
+        if len(spin):
+            W[spin] = _rows([st[i].angVel for i in spin.tolist()])
+
+        x1, x2 = P[i1], P[i2]
+        r1, r2 = self.radius[i1], self.radius[i2]
+        d = x2 - x1
+        dist = np.sqrt(_dot(d, d))
+        n = d / np.where(dist > 0, dist, 1.0)[:, None]  # unit normal from id1 to id2
+        delta = r1 + r2 - dist
+        v_rel0 = V[i1] - V[i2]
+        fn = np.maximum(0.0, kn * delta + cn * _dot(v_rel0, n))  # eq. 3, as the native law
+        a1 = r1[:, None] * n  # lever arms: the radii along the normal (docs/law.md step 1)
+        a2 = -r2[:, None] * n
+        other = np.flatnonzero(~ss)
+        if len(other):  # box/wall contacts: YADE's normal, contact point and normal force
+            g = [L[k].geom for k in other.tolist()]
+            n[other] = _rows([x.normal for x in g])
+            c = _rows([x.contactPoint for x in g])
+            fn[other] = [L[k].phys.normalForce.norm() for k in other.tolist()]
+            s1, s2 = self.sphere[i1[other]], self.sphere[i2[other]]
+            a1[other] = np.where(s1[:, None], r1[other, None] * n[other], c - x1[other])
+            a2[other] = np.where(s2[:, None], -r2[other, None] * n[other], c - x2[other])
+        if self.check:
+            self._check(L, ss, n, fn)
+
+        # Relative velocity of id1's contact point w.r.t. id2's, tangential part (eq. 6).
+        v_rel = v_rel0
+        if len(spin):
+            v_rel = v_rel + np.cross(W[i1], a1) - np.cross(W[i2], a2)
+        V_s = v_rel - _dot(v_rel, n)[:, None] * n
+
+        # The spring, turned into the current tangent plane keeping its length, then
+        # loaded by this step's tangential displacement (eq. 7).
+        dn = _dot(D, n)
         if dn.any():
-            old_len = np.einsum("ij,ij->i", D, D)
+            old_len = _dot(D, D)
             D = D - dn[:, None] * n
-            new_len = np.einsum("ij,ij->i", D, D)
-            D *= np.where(new_len > 0, np.sqrt(old_len / np.maximum(new_len, 1e-300)), 1.0)[:, None]
-        D = D + V_s * dt  # eq. 7
-        F_t = -self.ks * D - self.nu_s * V_s  # eq. 5
-        mag = np.sqrt(np.einsum("ij,ij->i", F_t, F_t))
-        slip = mag >= self.mu_s * fn  # Coulomb's static threshold
-        f_min = (2 * self.mu_k - self.mu_s) * fn
-        scale = np.where(slip, f_min / np.maximum(mag, 1e-300), 1.0)
-        F_s = F_t * scale[:, None]  # slip: Fmin along the trial direction
-        if self.reset == "spring":
-            D_slip = -F_s / self.ks  # eq. 8: Ks |D| = Fmin
-        else:
-            D_slip = -(F_s + self.nu_s * V_s) / self.ks  # spring + dashpot = Fmin
-        D = np.where(slip[:, None], D_slip, D)
+            new_len = _dot(D, D)
+            D *= np.where(new_len > 0, np.sqrt(old_len / np.where(new_len > 0, new_len, 1.0)), 1.0)[:, None]
+        D = D + V_s * dt
+        F_t = -self.ks * D - self.nu_s * V_s  # trial force on id1 (eq. 5)
+        mag = np.sqrt(_dot(F_t, F_t))
+        slip = mag >= self.mu_s * fn  # Coulomb's static threshold (Fn = 0 always slips)
+        F_s = F_t
+        if slip.any():  # kinetic phase: Fmin = (2 mu_k - mu_s) Fn along the trial force
+            f_min = (2.0 * self.mu_k - self.mu_s) * fn
+            F_s = F_t * np.where(slip, f_min / np.where(mag > 0, mag, 1.0), 1.0)[:, None]
+            if self.reset == "spring":
+                D_slip = -F_s / self.ks  # eq. 8: Ks |D| = Fmin
+            else:  # "total": spring + dashpot = Fmin (keeps a saw-tooth when nu_s |V_s| is large)
+                D_slip = -(F_s + self.nu_s * V_s) / self.ks
+            D = np.where(slip[:, None], D_slip, D)
+            count = count + slip
 
-        addF, addT = O.forces.addF, O.forces.addT
-        last = {}
-        for k, (i1, i2, made) in enumerate(keys):
-            f = F_s[k]
-            old = self.state.get((i1, i2))
-            count = (old[2] if old is not None and old[1] == made else 0) + int(slip[k])
-            state[(i1, i2)] = (D[k], made, count)
-            last[(i1, i2)] = (fn[k], f, bool(slip[k]))
-            F = Vector3(f[0], f[1], f[2])
-            addF(i1, F)
-            addF(i2, -F)
-            if self.lever_arms:
-                r1, r2 = refs[k]
-                nv = Vector3(n[k, 0], n[k, 1], n[k, 2])
-                addT(i1, (nv * r1).cross(F))
-                addT(i2, (nv * r2).cross(F))
-        self.state, self.last = state, last  # ended contacts are dropped here
+        # Forces and torques summed per body, one addF/addT per body that gets any.
+        self._add(O.forces.addF, i1, i2, F_s, -F_s, nb)
+        if self.rotation:
+            self._add(O.forces.addT, i1, i2, np.cross(a1, F_s), np.cross(a2, -F_s), nb)
+
+        order = np.argsort(key)  # ended contacts are not carried: their state is dropped
+        self.keys, self.made, self.D = key[order], made[order], D[order]
+        self.kn, self.cn, self.fn, self.F_s = kn[order], cn[order], fn[order], F_s[order]
+        self.slipped, self.count = slip[order], count[order]
+
+    @staticmethod
+    def _add(add, i1, i2, f1, f2, nb):
+        tot = np.empty((nb, 3))
+        for c in range(3):
+            tot[:, c] = np.bincount(i1, f1[:, c], nb) + np.bincount(i2, f2[:, c], nb)
+        got = np.flatnonzero(tot.any(axis=1))
+        for i, f in zip(got.tolist(), tot[got].tolist()):
+            add(i, f)
+
+    def _check(self, L, ss, n, fn):
+        """Recomputed sphere-sphere normals and normal forces against YADE's own."""
+        k = np.flatnonzero(ss)
+        if not len(k):
+            return
+        native_n = _rows([L[j].geom.normal for j in k.tolist()])
+        native_fn = np.array([L[j].phys.normalForce.norm() for j in k.tolist()])
+        err_n = float(np.abs(native_n - n[k]).max())
+        err_fn = float(np.abs(native_fn - fn[k]).max() / max(native_fn.max(), 1e-300))
+        self.max_fn_error = max(self.max_fn_error, err_fn)
+        self.checked += len(k)
+        if err_n > 1e-9 or err_fn > 1e-9:
+            raise RuntimeError(f"stick-slip law: recomputed geometry differs from YADE's "
+                               f"(normal {err_n:.3g}, relative Fn {err_fn:.3g})")
+
+    def contact(self, id1, id2):
+        """(Fn, F_s on id1, slipped this step, slip steps since made) or None."""
+        if id1 > id2:
+            got = self.contact(id2, id1)
+            return None if got is None else (got[0], -got[1], got[2], got[3])
+        if not len(self.keys):
+            return None
+        key = (id1 << 32) | id2
+        p = int(np.searchsorted(self.keys, key))
+        if p == len(self.keys) or self.keys[p] != key:
+            return None
+        return float(self.fn[p]), self.F_s[p].copy(), bool(self.slipped[p]), int(self.count[p])
+
+    def lookup(self, id1, id2):
+        """(Fn, F_s on id1, slipped this step) or None (what run_scene.py reads)."""
+        got = self.contact(id1, id2)
+        return None if got is None else got[:3]
+
+    def n_contacts(self):
+        return len(self.keys)
 
 
-def stickslip_engines(ks, nu_s, mu_s, mu_k, reset="spring", gravity=(0.0, 0.0, 0.0), rotation=False,
-                      extra=()):
+def stickslip_engines(ks, nu_s, mu_s, mu_k, reset="spring", gravity=(0.0, 0.0, 0.0), damping=0.0,
+                      rotation=True, extra=(), check=False):
     """The engine list for O.engines: collision detection, native normal law, this law,
-    then Newton's integration. `extra` engines (e.g. a RotationEngine) go before Newton."""
+    `extra` engines (e.g. a RotationEngine), then Newton's integration. The law object is
+    published as `builtins.stickslip_law` (a PyRunner's command runs in __main__)."""
     from yade import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, Bo1_Wall_Aabb, ForceResetter, Ig2_Box_Sphere_ScGeom,
                       Ig2_Sphere_Sphere_ScGeom, Ig2_Wall_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
                       Ip2_ViscElMat_ViscElMat_ViscElPhys, Law2_ScGeom_ViscElPhys_Basic, NewtonIntegrator,
                       PyRunner)
 
-    law = StickSlipLaw(ks, nu_s, mu_s, mu_k, reset, lever_arms=rotation)
-    # PyRunner commands run in __main__: publish the callable where any script sees it.
+    if isinstance(damping, bool) or not isinstance(damping, (int, float)) or not 0 <= damping < 1:
+        raise ValueError(f"damping = {damping!r}: must be in [0, 1)")
+    law = StickSlipLaw(ks, nu_s, mu_s, mu_k, reset, rotation=rotation, check=check)
     builtins.stickslip_law = law
     return [
         ForceResetter(),
         InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb(), Bo1_Box_Aabb()]),
         InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
                         [Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),
+        # initRun=True: otherwise the first step runs without the tangential force.
         PyRunner(command="stickslip_law.step()", iterPeriod=1, initRun=True, label="stickslip_runner"),
         *extra,
-        NewtonIntegrator(gravity=tuple(gravity), damping=0.0),
+        NewtonIntegrator(gravity=tuple(gravity), damping=damping),
     ]
