@@ -105,3 +105,13 @@ def test_tray_stick_slip_holds_grain_1_as_in_pyref(tmp_path):
     # Height above the bottom (grain 1 rests 0.1 mm up): within 1 %.
     r = sc.grains[0].radius
     assert sy["y1_final_m"] - r == pytest.approx(sp["y1_final_m"] - r, rel=0.01)
+
+
+@needs_yade
+def test_relative_output_folder(tmp_path, monkeypatch):
+    """Regression: `stickslip report` passes relative folders; yade runs in the output
+    folder, so the adapter must hand it absolute paths."""
+    monkeypatch.chdir(tmp_path)
+    sc = scene_mod.load("drag", duration=2e-4)
+    res = yade_adapter.run(sc, Path("rel") / "out")
+    assert len(res.timeseries) == sc.steps // sc.output.every + 1
