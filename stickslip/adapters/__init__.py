@@ -33,8 +33,8 @@ def available():
     for name in ENGINES:
         try:
             reason = get(name).available()
-        except ImportError as e:  # an adapter that has not landed yet
-            reason = f"adapter not importable ({e})"
+        except ModuleNotFoundError as e:  # an adapter that has not landed yet
+            reason = "no adapter yet" if e.name == f"stickslip.adapters.{name}" else f"cannot import ({e})"
         if reason is None:
             ok.append(name)
         else:
