@@ -163,7 +163,9 @@ def _plots(name, rows, out):
         rr = [r for r in rows if r["engine"] == eng and not r["reference"]]
         for k, mark in zip(keys, "os^"):
             dts = [r["dt_s"] for r in rr]
-            errs = [r[k] for r in rr]
+            # An error of exactly 0 (e.g. a period equal to the reference's to the step) has
+            # no place on a log axis: left out of the plot, kept in the CSV.
+            errs = [r[k] if r[k] and r[k] > 0 else math.nan for r in rr]
             p = convergence_order(dts, errs)
             orders[(eng, k[4:])] = p
             ax1.loglog([r["wall_time_s"] for r in rr], errs, mark + "-", label=f"{eng}: {k[4:]}")
