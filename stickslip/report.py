@@ -174,7 +174,7 @@ def _fmt(v):
 
 CLAIMS = {
     "drag": [("fs_fn_max", "max |Fs|/Fn = μs = 0.5"), ("fs_fn_min", "min |Fs|/Fn = 2μk − μs = 0.4"),
-             ("fs_fn_mean", "mean over whole periods = μk = 0.45"), ("slip_period_s", "period 2(μs−μk)Fn/(Ks·V)"),
+             ("fs_fn_mean", "mean over whole periods = μk = 0.45"), ("slip_period_s", "measured slip period (s)"), ("slip_period_paper_s", "paper: 2(μs−μk)Fn/(Ks·V)"),
              ("slip_period_expected_s", "same, less the dashpot's jump ν_s·V"), ("slip_count", "slips"),
              ("wall_time_s", "wall time (s)")],
     "tray": [("y1_final_m", "grain 1 final height (stays above r = 5 mm)"),
