@@ -1,0 +1,347 @@
+"""Adapter for LIGGGHTS 3.8 (Debian's package) with the stick_slip plugin.
+
+Writes a LIGGGHTS input script for the scene (2D scenes with `dimension 2`; only the
+effects the scene switches on), runs the plugin's launcher, and turns its dumps into
+the standard time series. Per-contact force and slip count come from the model's own
+record (`stick_slip_record on`: Fn, F_s and a slip counter kept in the contact history),
+because LIGGGHTS' contact computes re-evaluate contacts and would report, at a slip
+step, a force that was never applied.
+"""
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import RunResult
+
+NAME = "liggghts"
+REPO = Path(__file__).resolve().parents[2]
+LAUNCHER = REPO / "build" / "liggghts_plugin" / "liggghts-stickslip"
+# contact history layout of the stick_slip model with the record on (1-based, as LIGGGHTS counts):
+# D (3 values), then Fn, F_s (3), cumulative slip count
+RECORD_FN, RECORD_FS, RECORD_NSLIP = 4, 5, 8
+HISTORY_VALUES = 8
+
+
+def available():
+    if shutil.which("liggghts") is None:
+        return "LIGGGHTS not installed (apt-get install liggghts libliggghts-dev)"
+    if not LAUNCHER.is_file():
+        return f"plugin not built ({LAUNCHER} missing; ./run.sh setup builds it)"
+    return None
+
+
+def _fmt(x):
+    return repr(float(x))
+
+
+def _vec(a):
+    return " ".join(_fmt(x) for x in a)
+
+
+def _full_precision(dump, ncols, ints=0):
+    """Dumps print 6 digits by default; forces and positions are compared far below that."""
+    return f'dump_modify {dump} format "' + " ".join(["%d"] * ints + ["%.17g"] * (ncols - ints)) + '"'
+
+
+class _Script:
+    """The input script and the facts needed to read its output back."""
+
+    def __init__(self, scene, work: Path):
+        self.scene, self.work = scene, work
+        self.lines = []
+        self.ids = {g.name: i + 1 for i, g in enumerate(scene.grains)}
+        self.primitive = {}  # wall name -> fix id (per-atom history f_history_<id>)
+        self.mesh = {}  # wall name -> fix id
+        self._build()
+
+    def add(self, *lines):
+        self.lines.extend(lines)
+
+    def _box(self):
+        sc = self.scene
+        pos = np.array([g.position for g in sc.grains])
+        rmax = max(g.radius for g in sc.grains)
+        pts = np.vstack([pos] + [w.point[None, :] for w in sc.walls]) if sc.walls else pos
+        # room for the grains to move and for turning walls (half-length `reach`)
+        margin = 10 * rmax + 0.02
+        lo, hi = pts.min(axis=0) - margin, pts.max(axis=0) + margin
+        if sc.dimension == 2:
+            # z is periodic and inert in 2D, but as thick as the plane: LIGGGHTS bins mesh
+            # walls in 3D and needs a bin on either side of the grains
+            lo[2], hi[2] = -margin, margin
+        return lo, hi, margin
+
+    def _material(self):
+        c, eff = self.scene.contact, self.scene.effects
+        props = {"kn": c.kn, "kt": c.ks,
+                 "gamman_abs": c.nu_n if eff["normal_damping"] else 0.0,
+                 "gammat_abs": c.nu_s if eff["tangential_damping"] else 0.0,
+                 "coefficientFriction": c.mu_s, "coefficientKineticFriction": c.mu_k}
+        for k, (name, value) in enumerate(props.items()):
+            self.add(f"fix m{k} all property/global {name} peratomtypepair 1 {_fmt(value)}")
+        model = "model hooke/stiffness tangential stick_slip"
+        settings = "absolute_damping on limitForce on stick_slip_record on"
+        if c.reset == "total":
+            settings += " slip_reset_total on"
+        return model, settings
+
+    def _mesh_file(self, w, half):
+        """A wall as two triangles; the shared diagonal crosses the wall's point at half/2
+        off it, so a grain resting at the point touches one triangle only."""
+        n = w.normal / np.linalg.norm(w.normal)
+        if self.scene.dimension == 2:
+            t2 = np.array([0.0, 0.0, 1.0])
+            b = 0.45 * (self._hi[2] - self._lo[2])
+        else:
+            t2 = np.cross(n, [1.0, 0.0, 0.0] if abs(n[0]) < 0.9 else [0.0, 1.0, 0.0])
+            t2 /= np.linalg.norm(t2)
+            b = half
+        t1 = np.cross(t2, n)
+        c = [w.point + a * t1 + s * b * t2 for a, s in ((-half, -1), (2 * half, -1), (2 * half, 1), (-half, 1))]
+        path = self.work / f"wall_{w.name}.stl"
+        with open(path, "w") as f:
+            f.write("solid wall\n")
+            for tri in ((c[0], c[1], c[2]), (c[0], c[2], c[3])):
+                f.write(f" facet normal {_vec(n)}\n  outer loop\n")
+                for p in tri:
+                    f.write(f"   vertex {_vec(p)}\n")
+                f.write("  endloop\n endfacet\n")
+            f.write("endsolid wall\n")
+        return path.name
+
+    def _build(self):
+        sc, eff = self.scene, self.scene.effects
+        lo, hi, margin = self._box()
+        self._lo, self._hi = lo, hi
+        d2 = sc.dimension == 2
+        self.add("# written by stickslip (stickslip/adapters/liggghts.py) for scene " + sc.name,
+                 "atom_style sphere", "atom_modify map array", "units si", "newton off",
+                 "communicate single vel yes")
+        if d2:
+            self.add("dimension 2")
+        self.add("boundary f f p" if d2 else "boundary f f f",
+                 f"region box block {_fmt(lo[0])} {_fmt(hi[0])} {_fmt(lo[1])} {_fmt(hi[1])} "
+                 f"{_fmt(lo[2])} {_fmt(hi[2])} units box",
+                 "create_box 1 box")
+        rmax = max(g.radius for g in sc.grains)
+        self.add(f"neighbor {_fmt(0.2 * rmax)} bin", "neigh_modify delay 0")
+        model, settings = self._material()
+        self.add(f"pair_style gran {model} {settings}", "pair_coeff * *", f"timestep {_fmt(sc.dt)}")
+        for g in sc.grains:
+            i = self.ids[g.name]
+            self.add(f"create_atoms 1 single {_vec(g.position)} units box",
+                     f"set atom {i} diameter {_fmt(2 * g.radius)} density {_fmt(g.density)}")
+            if np.any(g.velocity):  # LIGGGHTS allows 32 groups: a group only while it is needed
+                self.add(f"group tmp id {i}", f"velocity tmp set {_vec(g.velocity)} units box", "group tmp delete")
+        half = 0.4 * margin  # a mesh wall spans [-half, 2 half] along the wall: inside the box when turned
+        for k, w in enumerate(sc.walls):
+            fid = f"w{k}"
+            axis = [j for j in range(3) if abs(w.normal[j]) == 1.0]
+            moving = w.rotation is not None or np.any(w.velocity)
+            if axis and not moving:
+                j = axis[0]
+                self.add(f"fix {fid} all wall/gran {model} primitive type 1 {'xyz'[j]}plane "
+                         f"{_fmt(w.point[j])} {settings}")
+                self.primitive[w.name] = fid
+                continue
+            stl = self._mesh_file(w, half)
+            self.add(f"fix mesh{k} all mesh/surface file {stl} type 1",
+                     f"fix {fid} all wall/gran {model} mesh n_meshes 1 meshes mesh{k} {settings}")
+            self.mesh[w.name] = fid
+            if w.rotation is not None:
+                if np.any(w.velocity):
+                    raise ValueError(f"wall {w.name}: a wall that both turns and translates is not supported on LIGGGHTS")
+                r = w.rotation
+                nrot, rate = sc.rotation_steps(w), sc.rotation_rate(w)
+                # turns during steps 1..nrot (`step` is the step being made), then held
+                self.add(f"variable omega{k} equal (step<={nrot})*{rate!r}",
+                         f"fix move{k} all move/mesh mesh mesh{k} rotate/variable origin {_vec(r.pivot)} "
+                         f"axis {_vec(r.axis)} omega v_omega{k}")
+            else:
+                self.add(f"fix move{k} all move/mesh mesh mesh{k} linear {_vec(w.velocity)}")
+        if eff["gravity"]:
+            g = np.asarray(sc.gravity, float)
+            gn = float(np.linalg.norm(g))
+            if gn > 0:
+                self.add(f"fix gravity all gravity {gn!r} vector {_vec(g / gn)}")
+        # rotation off: integrate translation only, spins stay zero (nothing paid for them)
+        self.add("fix integrate all nve/sphere" if eff["rotation"] else "fix integrate all nve")
+        for g in sc.grains:
+            if g.imposed:
+                comps = " ".join("0.0" if c in g.imposed else "NULL" for c in "xyz")
+                i = self.ids[g.name]
+                self.add(f"group g{i} id {i}", f"fix hold{i} g{i} setforce {comps}")
+        if d2:
+            self.add("fix twod all enforce2d")
+        self._output()
+
+    def _output(self):
+        sc = self.scene
+        every = sc.output.every
+        cols = "id x y z vx vy vz omegax omegay omegaz"
+        for name, fid in self.primitive.items():
+            cols += "".join(f" f_history_{fid}[{k}]" for k in range(RECORD_FN, RECORD_NSLIP + 1))
+        self.add(f"dump atoms all custom {every} atoms.dump {cols}", "dump_modify atoms sort id",
+                 _full_precision("atoms", len(cols.split()), ints=1))
+        pair_contacts = [c for c in sc.output.contacts if c[1] in self.ids] or sc.output.stats
+        mesh_contacts = {c[1] for c in sc.output.contacts if c[1] in self.mesh}
+        if sc.output.stats:
+            mesh_contacts |= set(self.mesh)
+        local = f"c_{{0}}[1] c_{{0}}[2] c_{{0}}[3] " + " ".join(
+            f"c_{{0}}[{3 + k}]" for k in range(RECORD_FN, RECORD_NSLIP + 1))
+        if pair_contacts:
+            self.add("compute pairs all pair/gran/local id history",
+                     f"dump pairs all local {every} pairs.dump {local.format('pairs')}",
+                     _full_precision("pairs", 8))
+        if mesh_contacts:
+            if len(mesh_contacts) > 1:
+                raise ValueError("LIGGGHTS records the contacts of one mesh (moving or oblique) wall only; "
+                                 f"the scene needs {sorted(mesh_contacts)}")
+            self.add("compute walls all wall/gran/local id history",
+                     f"dump walls all local {every} walls.dump {local.format('walls')}",
+                     _full_precision("walls", 8))
+        self.add(f"thermo {max(1, sc.steps // 50)}", "thermo_style custom step atoms",
+                 "thermo_modify norm no", f"run {sc.steps}")
+
+    def text(self):
+        return "\n".join(self.lines) + "\n"
+
+
+def _read_dump(path):
+    """Blocks of a LIGGGHTS dump: {step: 2D float array} ('atoms' or 'local' dumps)."""
+    blocks, step, rows, want = {}, None, [], None
+    with open(path) as f:
+        for line in f:
+            if line.startswith("ITEM: TIMESTEP"):
+                if step is not None:
+                    blocks[step] = np.array(rows, float).reshape(len(rows), -1) if rows else np.zeros((0, 0))
+                step, rows, want = int(next(f)), [], None
+            elif line.startswith("ITEM: NUMBER OF"):
+                want = int(next(f))
+            elif line.startswith("ITEM: ATOMS") or line.startswith("ITEM: ENTRIES"):
+                rows = [next(f).split() for _ in range(want)]
+    if step is not None:
+        blocks[step] = np.array(rows, float).reshape(len(rows), -1) if rows else np.zeros((0, 0))
+    return blocks
+
+
+def _timeseries(script, work):
+    sc = script.scene
+    d = sc.dimension
+    axes = "xyz"[:d]
+    atoms = _read_dump(work / "atoms.dump")
+    pairs = _read_dump(work / "pairs.dump") if (work / "pairs.dump").is_file() else {}
+    walls = _read_dump(work / "walls.dump") if (work / "walls.dump").is_file() else {}
+    steps = sorted(atoms)
+    cols = {"t": [s * sc.dt for s in steps]}
+    for name in sc.output.grains:
+        i = script.ids[name] - 1
+        blk = np.array([atoms[s][i] for s in steps])
+        for k, a in enumerate(axes):
+            cols[f"{name}_{a}"] = blk[:, 1 + k]
+        for k, a in enumerate(axes):
+            cols[f"{name}_v{a}"] = blk[:, 4 + k]
+        if sc.effects["rotation"]:
+            for k, a in enumerate("z" if d == 2 else "xyz"):
+                cols[f"{name}_w{a}"] = blk[:, 9 if d == 2 else 7 + k]
+    prim_order = list(script.primitive)
+    for a, b in sc.output.contacts:
+        c = f"{a}-{b}"
+        ia = script.ids[a]
+        rec = np.zeros((len(steps), 5))  # fn, fs (3), cumulative slips
+        for r, s in enumerate(steps):
+            if b in script.primitive:
+                base = 10 + 5 * prim_order.index(b)
+                rec[r] = atoms[s][ia - 1][base:base + 5]
+            else:
+                blk = pairs.get(s) if b in script.ids else walls.get(s)
+                if blk is None or not len(blk):
+                    continue
+                if b in script.ids:
+                    ib = script.ids[b]
+                    for row in blk:
+                        if {int(row[0]), int(row[1])} == {ia, ib}:
+                            sign = 1.0 if int(row[0]) == ia else -1.0  # the record is the force on the first grain
+                            rec[r] = [row[3], *(sign * row[4:7]), row[7]]
+                else:  # a mesh wall: one row per touched triangle, summed
+                    for row in blk[blk[:, 2].astype(int) == ia]:
+                        rec[r, :4] += row[3:7]
+                        rec[r, 4] += row[7]
+        cols[f"{c}_fn"] = rec[:, 0]
+        cols[f"{c}_fs"] = np.linalg.norm(rec[:, 1:4], axis=1)
+        for k, x in enumerate(axes):
+            cols[f"{c}_ft{x}"] = rec[:, 1 + k]
+        # slips since the previous row; a counter that drops means the contact was remade
+        count = rec[:, 4]
+        slips = np.diff(count, prepend=0.0)
+        slips = np.where(slips < 0, count, slips)
+        cols[f"{c}_slip"] = np.rint(slips).astype(int)
+    if sc.output.stats:
+        cols["n_contacts"], cols["ekin"] = _stats(sc, atoms, pairs, walls, steps, len(prim_order))
+    for name in sc.output.walls:
+        w = next(w for w in sc.walls if w.name == name)
+        nrot = sc.rotation_steps(w) if w.rotation else 0
+        rate = sc.rotation_rate(w) if w.rotation else 0.0
+        cols[f"{name}_angle"] = [rate * sc.dt * min(s, nrot) for s in steps]
+    return pd.DataFrame(cols)
+
+
+def _stats(sc, atoms, pairs, walls, steps, n_primitive):
+    """Contacts touching (Fn > 0 in the model's record) and kinetic energy, per row."""
+    m = np.array([sc.grain_mass(g) for g in sc.grains])
+    inertia = np.array([sc.grain_inertia(g) for g in sc.grains])
+    count, ekin = [], []
+    for s in steps:
+        a = atoms[s]
+        n = sum(int((a[:, 10 + 5 * k] > 0).sum()) for k in range(n_primitive))
+        for blk in (pairs.get(s), walls.get(s)):
+            if blk is not None and len(blk):
+                n += int((blk[:, 3] > 0).sum())
+        e = 0.5 * np.sum(m * np.sum(a[:, 4:7] ** 2, axis=1))
+        if sc.effects["rotation"]:
+            e += 0.5 * np.sum(inertia * np.sum(a[:, 7:10] ** 2, axis=1))
+        count.append(n)
+        ekin.append(e)
+    return count, ekin
+
+
+def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
+    if scene.contact.law != "stick_slip":
+        raise ValueError(f"the LIGGGHTS plugin implements stick_slip only, not {scene.contact.law}")
+    work = Path(out_dir).resolve() / "liggghts"
+    work.mkdir(parents=True, exist_ok=True)
+    for old in work.glob("*.dump"):
+        old.unlink()
+    script = _Script(scene, work)
+    (work / "in.scene").write_text(script.text())
+    cmd = [str(launcher or LAUNCHER), "-in", "in.scene", "-log", "log.liggghts", "-echo", "none"]
+    if np_ranks > 1:
+        cmd = ["mpirun", "-np", str(np_ranks)] + cmd
+    t0 = time.perf_counter()
+    loop, err = [], []
+    with open(work / "screen.txt", "w") as screen:
+        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=work)
+        for line in p.stdout:
+            screen.write(line)
+            fields = line.split()
+            if len(fields) == 2 and fields[0].isdigit() and progress is not None:
+                progress(int(fields[0]), scene.steps)
+            elif line.startswith("Loop time of"):
+                loop.append(float(line.split()[3]))
+            elif line.startswith("ERROR"):
+                err.append(re.sub(r"\s*\([^()]*:\d+\)\s*$", "", line[6:].strip()))
+        p.wait()
+    if err:
+        raise ValueError(f"LIGGGHTS: {err[0]}")
+    if p.returncode != 0 or not loop:
+        raise RuntimeError(f"LIGGGHTS failed (exit {p.returncode}); see {work / 'screen.txt'}")
+    df = _timeseries(script, work)
+    return RunResult(df, scene.steps, sum(loop) if loop else time.perf_counter() - t0)
