@@ -32,9 +32,14 @@ def run_pyref(sc, energy=False):
     return pd.DataFrame(rows, columns=columns), sim
 
 
-@functools.lru_cache(maxsize=None)
 def paper_case(name, law=None, duration=None):
     """The paper's cases are run once per test session and shared by the tests."""
+    # one cache key however the caller spells it (lru_cache keys keywords and positions apart)
+    return _paper_case(name, law, duration)
+
+
+@functools.lru_cache(maxsize=None)
+def _paper_case(name, law, duration):
     kw = {}
     if law:
         kw["law"] = law
