@@ -19,6 +19,7 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 #include "modify.h"
 #include "update.h"
 #include "error.h"
+#include "neighbor.h"
 #include <cmath>
 #include <cstdio>
 
@@ -107,6 +108,13 @@ public:
     registry.registerProperty("coeffKineticFrict", &StickSlip::createKineticFriction);
     registry.connect("coeffFrict", mu_s, "tangential_model stick_slip");
     registry.connect("coeffKineticFrict", mu_k, "tangential_model stick_slip");
+    // docs/law.md step 3: D must be dropped when a contact opens. LIGGGHTS calls
+    // surfacesClose() only for pairs closer than contactDistanceFactor * (r_i + r_j)
+    // (1 by default, i.e. never for an opened pair, whose history would then survive
+    // until the next neighbour-list rebuild). 1.01, as LIGGGHTS' own hooke model uses
+    // for its elastic energy: a contact opens by |v_n| dt per step, far below 1 % of
+    // r_i + r_j at any stable time step, so every opening is seen.
+    neighbor->register_contact_dist_factor(1.01);
   }
 
   inline void surfacesIntersect(const SurfacesIntersectData & sidata, ForceData & i_forces, ForceData & j_forces)
@@ -143,13 +151,16 @@ public:
     // eq. 5: trial force = spring + dashpot
     double F[3];
     for (int k = 0; k < 3; k++) F[k] = -kt * D[k] - gammat * vs[k];
-    const double mag = std::sqrt(F[0]*F[0] + F[1]*F[1] + F[2]*F[2]);
+    const double mag2 = F[0]*F[0] + F[1]*F[1] + F[2]*F[2];
     const double ms = mu_s[sidata.itype][sidata.jtype];
-    const bool slip = mag >= ms * fn;  // static threshold reached (Fn = 0 always slips)
+    const double limit = ms * fn;
+    // static threshold reached (Fn = 0 always slips); squared, so that a sticking step
+    // (the common case) needs no square root
+    const bool slip = mag2 >= limit * limit;
     if (slip) {
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) Fn along the trial force
       const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;
-      const double scale = mag > 0.0 ? fmin / mag : 0.0;
+      const double scale = mag2 > 0.0 ? fmin / std::sqrt(mag2) : 0.0;
       for (int k = 0; k < 3; k++) F[k] *= scale;
       // eq. 8: reset the spring so that it carries Fmin (or spring + dashpot do)
       for (int k = 0; k < 3; k++)

@@ -328,7 +328,10 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     t0 = time.perf_counter()
     loop, err = [], []
     with open(work / "screen.txt", "w") as screen:
-        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=work)
+        # errors="replace": LIGGGHTS 3.8's Error::all() sometimes appends bytes read through
+        # a dangling pointer (its "special message"), which are not valid UTF-8
+        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                             encoding="utf-8", errors="replace", cwd=work)
         for line in p.stdout:
             screen.write(line)
             fields = line.split()
@@ -345,3 +348,11 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
         raise RuntimeError(f"LIGGGHTS failed (exit {p.returncode}); see {work / 'screen.txt'}")
     df = _timeseries(script, work)
     return RunResult(df, scene.steps, sum(loop) if loop else time.perf_counter() - t0)
+
+
+def benchmark(reps=3):
+    """Rows for `stickslip bench`: the plugin's overhead against stock `tangential
+    history` and the MPI speed-up on 20 800 spheres (stickslip/liggghts_bench.py)."""
+    from ..liggghts_bench import benchmark as liggghts_benchmark
+
+    return liggghts_benchmark(reps)
