@@ -167,6 +167,9 @@ def run_bench(out: Path, reps=3, engines=None):
         lines.append("| " + " | ".join(_fmt(r.get(k)) for k in fields) + " |")
     for e, why in missing.items():
         lines.append(f"\n{e}: not measured ({why})")
+    if any(r["benchmark"] == "liggghts" for r in rows):
+        from .liggghts_bench import SCALING_NOTE
+        lines += ["", SCALING_NOTE]
     (out / "bench.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     return rows

@@ -343,6 +343,20 @@ def benchmark(reps=3):
     return rows
 
 
+# What the two-process figure says about more machines; written under the table of bench.md.
+SCALING_NOTE = """\
+LIGGGHTS beyond one machine: the box is cut into one sub-domain per MPI process
+(`processors`); a process owns the grains inside its sub-domain, keeps ghost copies of the
+grains within one neighbour cutoff of its faces, and a contact's history moves with its
+grain. Per step a process computes ~N/P grains and exchanges only the ghost layer with
+its neighbouring sub-domains, ~(N/P)^(2/3) grains in 3D. So the speed-up stays close to P
+while each process keeps many grains (thousands) and the grains fill the box evenly; with
+fewer grains per process the halo exchange's latency over the network dominates.
+LIGGGHTS-PUBLIC 3.8 has no dynamic load balancing: for a pour that fills part of the box,
+choose a `processors` grid that cuts only where grains are (e.g. `processors * * 1`
+for a layer)."""
+
+
 def _table(rows):
     lines = [f"{'case':<100} {'contacts':>9} {'value':>12}"]
     for r in rows:

@@ -211,8 +211,14 @@ def _markdown(results, engines, skipped, figs):
         for key, text in claims:
             vals = [_fmt(results[(label, e)][0].get(key)) for e in present]
             lines.append(f"| {text.replace('|', chr(92) + '|')} | " + " | ".join(vals) + " |")
-        notes = [n for e in present for n in results[(label, e)][0].get("notes", [])]
-        lines += [""] + [f"> warning: {n}" for n in notes] + [""]
+        # one line per distinct warning, naming the engines it came from
+        notes = {}
+        for e in present:
+            for n in results[(label, e)][0].get("notes", []):
+                notes.setdefault(n, []).append(e)
+        lines += [""] + [f"> warning ({', '.join(es)}): {n}" for n, es in notes.items()] + [""]
+        if label.split("_", 1)[-1] in PYREF_ONLY_LAWS:
+            lines += ["(pyref only: the paper's comparison law; the engines ship only the stick-slip law)", ""]
     lines += ["## Figures", ""]
     for name in figs:
         lines += [f"![{name}]({name})", ""]
