@@ -39,7 +39,7 @@ class Simulation:
         self.N = len(g)
         self.x = np.array([q.position for q in g], float)
         self.v = np.array([q.velocity for q in g], float)
-        self.w = np.zeros((self.N, 3))
+        self.w = np.array([q.angular_velocity for q in g], float)  # zero unless effects.rotation
         self.r = np.array([q.radius for q in g])
         self.m = np.array([s.grain_mass(q) for q in g])
         self.inertia = np.array([s.grain_inertia(q) for q in g])

@@ -174,6 +174,17 @@ def _busy_jiffies():
     return sum(v) - v[3] - (v[4] if len(v) > 4 else 0)  # all but idle and iowait
 
 
+def _vm_hwm_kib(pid):
+    try:
+        with open(f"/proc/{pid}/status") as f:
+            for line in f:
+                if line.startswith("VmHWM:"):
+                    return float(line.split()[1])
+    except OSError:
+        pass
+    return 0.0
+
+
 def _run(args, cwd, timeout=3600, info=None):
     """Run a LIGGGHTS command line; returns (stdout, peak RSS of the process in MiB).
     `info`, a dict, receives `foreign_cores`: the CPU the rest of the machine used meanwhile,
@@ -182,7 +193,11 @@ def _run(args, cwd, timeout=3600, info=None):
     with open(cwd / "stdout.txt", "w+", errors="replace") as out:
         p = subprocess.Popen(args, cwd=cwd, stdout=out, stderr=subprocess.STDOUT, env=_env(), text=True)
         t0 = time.monotonic()
-        while True:  # wait4, not wait: its rusage is this child's own (ru_maxrss in KiB on Linux)
+        hwm = 0.0
+        while True:
+            # peak RSS from /proc (VmHWM, KiB): ru_maxrss would also count the memory of this
+            # Python process, which the child shares between fork and exec
+            hwm = max(hwm, _vm_hwm_kib(p.pid))
             pid, status, usage = os.wait4(p.pid, os.WNOHANG)
             if pid:
                 break
@@ -203,7 +218,7 @@ def _run(args, cwd, timeout=3600, info=None):
         lines = text.strip().splitlines() or ["no output"]
         why = next((x.strip() for x in lines if "ERROR" in x), lines[-1].strip())
         raise RuntimeError(f"{' '.join(map(str, args[:3]))} ... failed (exit {p.returncode}) in {cwd}: {why}")
-    return text, usage.ru_maxrss / 1024.0
+    return text, hwm / 1024.0
 
 
 def _packing():

@@ -45,6 +45,8 @@ class Grain:
     position: np.ndarray  # always 3 components; z = 0 in 2D
     velocity: np.ndarray
     imposed: tuple = ()  # velocity components held at their initial value: "x", "y", "z"
+    # initial spin, rad/s, always 3 components (2D: about z only); needs effects.rotation
+    angular_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
 
 
 @dataclass
@@ -237,6 +239,18 @@ class _Table:
             raise SceneError(f"{self.key(unknown[0])}: unknown key")
 
 
+def _spin(gt, dim, rotation):
+    """A grain's initial angular velocity: a number (about z) in 2D, 3 numbers in 3D."""
+    if dim == 2:
+        w = np.zeros(3)
+        w[2] = gt.number("angular_velocity", 0.0)
+    else:
+        w = gt.vector("angular_velocity", 3, default=[0.0, 0.0, 0.0])
+    if np.any(w) and not rotation:
+        raise SceneError(f"{gt.key('angular_velocity')}: a spinning grain needs effects.rotation = true")
+    return w
+
+
 def find(name_or_path) -> Path:
     """A scene given as a path, or as a name in cases/ (with or without .toml)."""
     p = Path(name_or_path)
@@ -322,6 +336,7 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
             position=gt.vector("position", dim, required=True),
             velocity=gt.vector("velocity", dim, default=[0.0] * dim),
             imposed=_axes(gt, "imposed", dim),
+            angular_velocity=_spin(gt, dim, effects["rotation"]),
         ))
         gt.done()
     for i, b in enumerate(top.get("lattice", [])):

@@ -39,6 +39,8 @@ def edit(old, new, text=DRAG):
     ("contacts = [[\"grain\", \"floor\"]]", "contacts = [[\"grain\", \"roof\"]]", ["output.contacts"]),
     ("gravity = true", "gravity = false\nmagnetism = true", ["effects.magnetism", "unknown key"]),
     ("normal = [0.0, 1.0]", "normal = [0.0, 1.0]\nvelocity = [1.0, 0.0]", ["moving_walls"]),
+    # drag has rotation off: a spinning grain needs it; in 2D the spin is one number (about z)
+    ("imposed = [\"x\"]", "imposed = [\"x\"]\nangular_velocity = 5.0", ["grain[0].angular_velocity", "rotation"]),
 ])
 def test_bad_scene_names_key_and_range(old, new, words):
     with pytest.raises(SceneError) as e:
@@ -47,6 +49,14 @@ def test_bad_scene_names_key_and_range(old, new, words):
     assert "\n" not in msg
     for w in words:
         assert w in msg, (w, msg)
+
+
+def test_angular_velocity_is_one_number_in_2d_and_needs_rotation():
+    spinning = edit("rotation = false", "rotation = true")
+    sc = parse(edit("imposed = [\"x\"]", "imposed = [\"x\"]\nangular_velocity = 5.0", spinning))
+    assert list(sc.grains[0].angular_velocity) == [0.0, 0.0, 5.0]
+    with pytest.raises(SceneError, match=r"grain\[0\]\.angular_velocity: expected a finite number"):
+        parse(edit("imposed = [\"x\"]", "imposed = [\"x\"]\nangular_velocity = [0.0, 5.0]", spinning))
 
 
 def test_shipped_cases_are_valid():

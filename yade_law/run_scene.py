@@ -56,6 +56,7 @@ def build(sc):
             blocked += "XYZ" if sc["dimension"] == 3 else "Z"
         b.state.blockedDOFs = "".join(sorted(set(blocked), key=blocked.index))
         b.state.vel = Vector3(*g["velocity"])
+        b.state.angVel = Vector3(*g["angular_velocity"])
         ids[g["name"]] = O.bodies.append(b)
     rotators = []
     for w in sc["walls"]:

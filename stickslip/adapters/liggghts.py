@@ -117,6 +117,20 @@ class _Script:
             f.write("endsolid wall\n")
         return path.name
 
+    def _data_file(self, lo, hi):
+        """The box and the grains as a LIGGGHTS data file (atom_style sphere): the only way
+        LIGGGHTS 3.8 takes an initial spin (its `set` has no omega). In 2D LIGGGHTS makes
+        the mass pi r^2 rho, per unit thickness, as the scene means it."""
+        rows = ["grains written by stickslip", "", f"{len(self.scene.grains)} atoms", "1 atom types"]
+        rows += [f"{_fmt(lo[k])} {_fmt(hi[k])} {a}lo {a}hi" for k, a in enumerate("xyz")]
+        rows += ["", "Atoms", ""]
+        rows += [f"{self.ids[g.name]} 1 {_fmt(2 * g.radius)} {_fmt(g.density)} {_vec(g.position)}"
+                 for g in self.scene.grains]
+        rows += ["", "Velocities", ""]
+        rows += [f"{self.ids[g.name]} {_vec(g.velocity)} {_vec(g.angular_velocity)}" for g in self.scene.grains]
+        (self.work / "grains.data").write_text("\n".join(rows) + "\n")
+        return "grains.data"
+
     def _build(self):
         sc, eff = self.scene, self.scene.effects
         lo, hi, margin = self._box()
@@ -127,20 +141,11 @@ class _Script:
                  "communicate single vel yes")
         if d2:
             self.add("dimension 2")
-        self.add("boundary f f p" if d2 else "boundary f f f",
-                 f"region box block {_fmt(lo[0])} {_fmt(hi[0])} {_fmt(lo[1])} {_fmt(hi[1])} "
-                 f"{_fmt(lo[2])} {_fmt(hi[2])} units box",
-                 "create_box 1 box")
+        self.add("boundary f f p" if d2 else "boundary f f f", f"read_data {self._data_file(lo, hi)}")
         rmax = max(g.radius for g in sc.grains)
         self.add(f"neighbor {_fmt(0.2 * rmax)} bin", "neigh_modify delay 0")
         model, settings = self._material()
         self.add(f"pair_style gran {model} {settings}", "pair_coeff * *", f"timestep {_fmt(sc.dt)}")
-        for g in sc.grains:
-            i = self.ids[g.name]
-            self.add(f"create_atoms 1 single {_vec(g.position)} units box",
-                     f"set atom {i} diameter {_fmt(2 * g.radius)} density {_fmt(g.density)}")
-            if np.any(g.velocity):  # LIGGGHTS allows 32 groups: a group only while it is needed
-                self.add(f"group tmp id {i}", f"velocity tmp set {_vec(g.velocity)} units box", "group tmp delete")
         half = 0.4 * margin  # a mesh wall spans [-half, 2 half] along the wall: inside the box when turned
         for k, w in enumerate(sc.walls):
             fid = f"w{k}"

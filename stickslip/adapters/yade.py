@@ -48,6 +48,7 @@ def scene_dict(scene):
         "dt": scene.dt, "steps": scene.steps, "every": scene.output.every,
         "grains": [{"name": g.name, "radius": g.radius, "mass": scene.grain_mass(g),
                     "inertia": scene.grain_inertia(g), "position": v(g.position), "velocity": v(g.velocity),
+                    "angular_velocity": [float(c) for c in g.angular_velocity],
                     "imposed": list(g.imposed)} for g in scene.grains],
         "walls": walls,
         "output": {"grains": scene.output.grains, "contacts": scene.output.contacts, "walls": scene.output.walls,
