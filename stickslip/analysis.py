@@ -147,20 +147,29 @@ def tilt(scene, df):
     if end > first:
         out["accel_stick_slip_mps2"] = float((u[end] - u[first]) / (t[end] - t[first]))
         out["stick_slip_duration_s"] = float(t[end] - t[first])
-    out.update(_resolution(df, c, every))
+    # Where the dashpot alone covers the force drop, nu_s*V >= 2(mu_s - mu_k)*Fn, every
+    # step slips at any dt: physics, not a time-step artefact (docs/precision.md).
+    nu_s = p.nu_s if scene.effects["tangential_damping"] else 0.0
+    dashpot = nu_s * np.abs(u) >= 2 * (p.mu_s - p.mu_k) * df[f"{c}_fn"].to_numpy()
+    out.update(_resolution(df, c, every, dashpot))
     return out
 
 
-def _resolution(df, c, every):
+def _resolution(df, c, every, dashpot=None):
     """How well the run resolved its stick phases. With a row per step: the share of slips
     that followed fewer than RESOLVED_STICK_STEPS stick steps. With coarser rows: the
-    share of rows with slips in which every step slipped (no stick step at all)."""
+    share of rows with slips in which every step slipped (no stick step at all). Rows
+    flagged in `dashpot` (the dashpot alone makes every step slip) are not counted."""
+    slips = df[f"{c}_slip"].to_numpy()
+    counted = np.ones(len(slips), bool) if dashpot is None else ~dashpot
     gaps = stick_resolution(df, c, every)
     if gaps is not None:
+        gaps = gaps[counted[np.nonzero(slips > 0)[0][1:]]]
+        if not len(gaps):
+            return {}
         poor = int(np.sum(gaps < RESOLVED_STICK_STEPS))
         return {"stick_steps_median": float(np.median(gaps)), "slips_underresolved_share": poor / len(gaps)}
-    slips = df[f"{c}_slip"].to_numpy()
-    rows = slips > 0
+    rows = (slips > 0) & counted
     if every > 1 and rows.sum() >= 2:
         return {"rows_all_slip_share": float(np.mean(slips[rows] >= every))}
     return {}
@@ -176,5 +185,6 @@ def warnings(scene, summary) -> list:
     if share is not None and share > 0.1:
         return [f"{share:.0%} {what}: the time step (dt = {scene.dt:g} s) under-resolves the stick phase "
                 f"there, so friction sits at (2 mu_k - mu_s)*Fn instead of averaging mu_k*Fn; every step "
-                f"slips once V*(Ks*dt + nu_s) >= 2(mu_s - mu_k)*Fn (see docs/precision.md)"]
+                f"slips once V*(Ks*dt + nu_s) >= 2(mu_s - mu_k)*Fn (see docs/precision.md; where nu_s*V alone "
+                f"reaches it, that is physics and not counted)"]
     return []

@@ -47,6 +47,8 @@ def build_parser():
     pr.add_argument("--engine", nargs="+", default=["pyref"], choices=ENGINES, dest="engines")
     pr.add_argument("--factors", nargs="+", type=_positive,
                     help="dt multipliers (default: 8 4 2 1 0.5 0.25)")
+    pr.add_argument("--reference", default="pyref", choices=ENGINES,
+                    help="engine whose finest run is the reference (default: pyref)")
     pr.add_argument("--out", type=Path, help="output folder (default: precision/SCENE)")
     pr.add_argument("--quiet", action="store_true", help="no progress bars")
 
@@ -149,7 +151,7 @@ def cmd_precision(args):
     out = args.out or Path("precision") / sc.name
     out.mkdir(parents=True, exist_ok=True)
     csv_path, orders = run_precision(args.scene, args.engines, out, args.factors and tuple(args.factors),
-                                     progress=not args.quiet)
+                                     progress=not args.quiet, reference=args.reference)
     for (eng, measure), p in sorted(orders.items()):
         print(f"{eng:9s} {measure:18s} convergence order {p:.2f}")
     print(f"wrote {csv_path} and the diagrams in {out}")

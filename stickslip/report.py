@@ -193,6 +193,11 @@ CLAIMS = {
 }
 
 
+def _nu_over_ks(case):
+    c = scene_mod.load(case).contact
+    return c.nu_s / c.ks
+
+
 def _markdown(results, engines, skipped, figs):
     lines = ["# stickslip report", "",
              "The paper's three cases (Khellaf & Mansouri 2024, section 3) run from the scene files in "
@@ -250,7 +255,10 @@ def _precision_section(out, engines, progress):
                       "at V* = 2(μs−μk)Fn/(Ks·dt + νs). The dashpot part νs of that limit is physics; the Ks·dt "
                       "part is a time-step artefact, so the length of the stick-slip stretch and the speed at "
                       "which steady sliding starts depend on dt, while the steady acceleration (friction Fmin) "
-                      "does not.", "", f"![tilt velocity by dt](precision/{case}/precision_tilt_velocity.png)", ""]
+                      "does not. The velocity history converges (first order) only once Ks·dt ≪ νs, i.e. "
+                      f"dt ≪ νs/Ks = {_nu_over_ks('tilt'):.2g} s, below this ladder's finest step: how far, in "
+                      "[docs/precision.md](../docs/precision.md) (a finer ladder with LIGGGHTS as the reference).",
+                      "", f"![tilt velocity by dt](precision/{case}/precision_tilt_velocity.png)", ""]
     rows = run_thresholds(out / "thresholds")
     worst = max(abs(r["rel_diff"]) for r in rows)
     lines += ["### Speed above which every step slips", "",

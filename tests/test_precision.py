@@ -43,3 +43,26 @@ def test_under_resolved_run_warns_once_and_resolved_run_does_not():
     df, _ = run_pyref(fast)
     w = analysis.warnings(fast, analysis.summarise(fast, df))
     assert len(w) == 1 and "under-resolves the stick phase" in w[0]
+
+
+def test_precision_reference_engine(tmp_path):
+    """`--reference liggghts`: the finest LIGGGHTS run is the reference and pyref's need
+    not run at all. On the drag, LIGGGHTS equals pyref at equal dt to round-off, so the
+    errors must be those of a pyref-referenced ladder to 1e-9 (relative errors ~1e-3..1)."""
+    from stickslip import adapters
+
+    reason = adapters.get("liggghts").available()
+    if reason is not None:
+        pytest.skip(f"liggghts: {reason}")
+    factors = (4, 2, 1, 0.5)
+    lig, _ = run_precision("drag", ["liggghts"], tmp_path / "lig", factors, progress=False, reference="liggghts")
+    ref, _ = run_precision("drag", ["pyref"], tmp_path / "ref", factors, progress=False)
+    rows_l = list(csv.DictReader(open(lig)))
+    rows_p = list(csv.DictReader(open(ref)))
+    assert {r["engine"] for r in rows_l} == {"liggghts"}
+    assert [float(r["dt_s"]) for r in rows_l if r["reference"] == "True"] == [min(factors) * 2e-6]
+    for a, b in zip(rows_l, rows_p):
+        assert float(a["dt_s"]) == float(b["dt_s"])
+        for k in ("err_mean_friction", "err_slip_period"):
+            if a["reference"] == "False":
+                assert float(a[k]) == pytest.approx(float(b[k]), rel=1e-9, abs=1e-12)
