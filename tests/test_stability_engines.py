@@ -170,6 +170,7 @@ def test_sustained_slide_yade(tmp_path):
     sustained_slide("yade", tmp_path)  # ~4 min
 
 
+# ~1 min on LIGGGHTS, ~25 min on YADE (80 000 steps through the Python law)
 @pytest.mark.parametrize("engine", [pytest.param("liggghts"), pytest.param("yade", marks=pytest.mark.slow)])
 def test_large_pour_settles(engine, tmp_path):
     """test_packing's 3000-disk pour (rotation, damping, gravity on) on an engine: every
