@@ -1,15 +1,29 @@
 """The contact laws of Khellaf & Mansouri (2024), vectorised over contacts.
 
-This file is the only place where pyref computes contact forces; it follows
-docs/law.md line by line. Arrays have one row per contact; vectors are (K, 3).
+This is the one numpy kernel of the law: pyref and the YADE law both call it
+(yade_law/stickslip_yade.py imports this file). It follows docs/law.md line by
+line. Arrays have one row per contact; vectors are (K, 3). It needs numpy only.
 Sign convention: forces are those acting on grain i; `V_s` is the tangential
 velocity of i's contact point relative to j's, so friction opposes it.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
+
+LAWS = ("stick_slip", "visco_elastic", "visco_plastic", "coulomb")
+RESETS = ("spring", "total")
+SLIP_TIMINGS = ("step", "exact")
+
+# Exact slip timing (docs/law.md, "Exact slip timing"): slips are followed one by one
+# until the force direction has settled along -V_s (its part across -V_s below
+# SETTLED times mu_s*Fn, so that it changes the slip level by less than round-off,
+# SETTLED^2/2 < 1e-16) or MAX_EXPLICIT_SLIPS slips have been followed in the step;
+# the remaining slips of the step then have a closed form.
+SETTLED = 1e-8
+MAX_EXPLICIT_SLIPS = 100
 
 
 @dataclass
@@ -22,11 +36,21 @@ class LawParams:
     mu_s: float
     mu_k: float
     reset: str = "spring"  # spring (eq. 8 read literally) | total
+    slip_timing: str = "step"  # step (the paper: slip tested at the end of the step) | exact
 
     @property
     def has_spring(self) -> bool:
         """Laws that keep a tangential history (a spring elongation D per contact)."""
         return self.law in ("stick_slip", "visco_elastic")
+
+
+class TangentialStep(NamedTuple):
+    """One step of the tangential law for K contacts."""
+    force: np.ndarray  # (K, 3) force on i applied over the step
+    spring: np.ndarray  # (K, 3) spring elongation D at the end of the step
+    slipped: np.ndarray  # (K,) bool: at least one slip during the step
+    dissipated_dashpot: np.ndarray | None  # (K,) energy the dashpot took (energy=True)
+    dissipated_slip: np.ndarray | None  # (K,) energy the slips took (energy=True)
 
 
 def normal_force(delta, v_n, p: LawParams):
@@ -50,46 +74,201 @@ def rotate_history(D, n):
     return D * np.where(new > 0, scale, 1.0)[:, None]
 
 
-def tangential_force(D, V_s, fn, dt, p: LawParams):
+def tangential_force(D, V_s, fn, dt, p: LawParams, energy=False) -> TangentialStep:
     """One step of the tangential law for all contacts.
 
     D: spring elongation from the previous step, already in the tangent plane.
-    Returns (F_s, D_new, slipped) where slipped is a bool array.
+    energy: also return what the dashpot and the slips dissipated (docs/law.md, Energy).
     """
-    if p.law == "coulomb":
-        return _coulomb(V_s, fn, p), D, np.zeros(len(fn), bool)
-    if p.law == "visco_plastic":
-        return _visco_plastic(V_s, fn, p), D, np.zeros(len(fn), bool)
+    if p.law in ("coulomb", "visco_plastic"):
+        F = _coulomb(V_s, fn, p) if p.law == "coulomb" else _visco_plastic(V_s, fn, p)
+        e = -_dot(F, V_s) * dt if energy else None
+        zero = np.zeros(len(fn)) if energy else None
+        return TangentialStep(F, D, np.zeros(len(fn), bool), zero if p.law == "coulomb" else e,
+                              e if p.law == "coulomb" else zero)
 
     if p.law == "visco_elastic":
         mu_s = mu_k = p.mu_k  # Table 1 uses one coefficient, mu = mu_k, for the classic laws
     else:
         mu_s, mu_k = p.mu_s, p.mu_k
 
+    D_start = D
     D = D + V_s * dt  # eq. 7: the spring follows the relative tangential displacement
     F_t = -p.ks * D  # eq. 5 (stick): elastic ...
     if p.nu_s:
         F_t = F_t - p.nu_s * V_s  # ... plus viscous part
-    mag = np.sqrt(np.einsum("ij,ij->i", F_t, F_t))
-    slip = mag >= mu_s * fn  # Coulomb's static threshold reached (Fn = 0 always slips)
-    if not slip.any():
-        return F_t, D, slip
+    mag = np.sqrt(_dot(F_t, F_t))
+    limit = mu_s * fn
+    slip = mag >= limit  # Coulomb's static threshold reached (Fn = 0 always slips)
+    stick_share = None
+    if p.slip_timing == "exact":
+        # The force moves along a straight line during the step; |F| is convex in time,
+        # so no slip happened inside the step iff it was below the threshold at both ends.
+        F_0 = -p.ks * D_start - p.nu_s * V_s
+        slip = slip | (_dot(F_0, F_0) >= limit * limit)
+        F_s, D, stick_share = F_t.copy(), D.copy(), np.ones(len(fn))
+        k = np.flatnonzero(slip)
+        if len(k):
+            F_s[k], D[k], stick_share[k] = _exact_slips(D_start[k], V_s[k], fn[k], dt, p, mu_s, mu_k)
+    elif not slip.any():
+        F_s = F_t
+    else:
+        # Slip (kinematic phase): the force drops to Fmin = (2 mu_k - mu_s) Fn along the
+        # trial direction, so that a slow saw-tooth averages mu_k*Fn (section 2.3).
+        # (Fn = 0 and |F_t| = 0 gives Fmin = 0 and scale 0.)
+        f_min = (2.0 * mu_k - mu_s) * fn
+        scale = np.where(slip, f_min / np.maximum(mag, 1e-300), 1.0)
+        F_s = F_t * scale[:, None]
+        if p.reset == "spring":
+            D_slip = -F_s / p.ks  # eq. 8: Ks*|D_s| = Fmin, along the force
+        else:  # "total": spring + dashpot equal Fmin, so a saw-tooth survives a strong dashpot
+            D_slip = -(F_s + p.nu_s * V_s) / p.ks
+        D = np.where(slip[:, None], D_slip, D)
+    if not energy:
+        return TangentialStep(F_s, D, slip, None, None)
+    if stick_share is None:
+        stick_share = (~slip).astype(float)
+    # Work the contact received this step, less what its spring stored; the dashpot's
+    # share is nu_s |V_s|^2 over the time the contact stuck (docs/law.md, Energy).
+    total = -_dot(F_s, V_s) * dt - 0.5 * p.ks * (_dot(D, D) - _dot(D_start, D_start))
+    dashpot = p.nu_s * _dot(V_s, V_s) * dt * stick_share
+    return TangentialStep(F_s, D, slip, dashpot, total - dashpot)
 
-    # Slip (kinematic phase): the force drops to Fmin = (2 mu_k - mu_s) Fn along the
-    # trial direction, so that a slow saw-tooth averages mu_k*Fn (section 2.3).
-    # (Fn = 0 and |F_t| = 0 gives Fmin = 0 and scale 0.)
+
+def _exact_slips(D0, V_s, fn, dt, p, mu_s, mu_k):
+    """Steps in which at least one slip happens, with every slip at its exact time.
+
+    V_s and Fn are constant over the step, so the trial force F = -Ks*D - nu_s*V_s
+    moves along u = -V_s/|V_s| at `rate` = Ks|V_s|dt per unit of step fraction theta.
+    Returns the force at the end of the step (the one applied, as in a step without
+    slip), the spring at the end, and the share of the step spent sticking
+    (docs/law.md, "Exact slip timing", steps E1-E7).
+    """
+    K = len(fn)
+    T = mu_s * fn  # static threshold
     f_min = (2.0 * mu_k - mu_s) * fn
-    scale = np.where(slip, f_min / np.maximum(mag, 1e-300), 1.0)
-    F_s = F_t * scale[:, None]
-    if p.reset == "spring":
-        D_slip = -F_s / p.ks  # eq. 8: Ks*|D_s| = Fmin, along the force
-    else:  # "total": spring + dashpot equal Fmin, so a saw-tooth survives a strong dashpot
-        D_slip = -(F_s + p.nu_s * V_s) / p.ks
-    return F_s, np.where(slip[:, None], D_slip, D), slip
+    r = (2.0 * mu_k - mu_s) / mu_s  # Fmin/T, a parameter: exactly 1 iff mu_k = mu_s
+    speed = np.sqrt(_dot(V_s, V_s))
+    u = np.divide(-V_s, speed[:, None], out=np.zeros_like(V_s), where=speed[:, None] > 0)
+    rate = p.ks * speed * dt
+    # After a slip the trial force restarts from Fmin*t + kept*u (E3): the spring holds
+    # Fmin and the dashpot adds nu_s|V_s| (reset "spring"), or both hold Fmin ("total").
+    kept = p.nu_s * speed if p.reset == "spring" else np.zeros(K)
+    flow_law = r == 1.0 and (p.reset == "total" or p.nu_s == 0)  # E6 applies
+
+    F = -p.ks * D0 - p.nu_s * V_s  # trial force at theta = 0
+    theta = np.zeros(K)
+    stick = np.zeros(K)  # share of the step spent sticking
+    trial_end = np.zeros((K, 3))  # trial force (spring + dashpot) at the end of the step
+    applied = np.zeros((K, 3))  # force at the end of the step
+    slips = np.zeros(K, np.int64)
+    active = T > 0
+    # E1. No normal force: no friction; the spring keeps what the reset leaves.
+    trial_end[~active] = kept[~active, None] * u[~active]
+
+    def finish(i, trial, force, stuck):
+        trial_end[i], applied[i] = trial, force
+        stick[i] += stuck
+        active[i] = False
+
+    while active.any():
+        a = np.flatnonzero(active)
+        # E2. Next slip: the first theta at which |F| reaches T. Before the step's first
+        # slip the force may already be at or above T (Fn fell, or V_s jumped): slip now.
+        f = _dot(F[a], u[a])
+        F2 = _dot(F[a], F[a])
+        gap = np.maximum(np.sqrt(np.maximum(T[a] ** 2 - (F2 - f * f), 0.0)) - f, 0.0)
+        dtheta = np.divide(gap, rate[a], out=np.full(len(a), np.inf), where=rate[a] > 0)
+        dtheta[(slips[a] == 0) & (F2 >= T[a] ** 2)] = 0.0
+        hit = theta[a] + dtheta <= 1.0
+        s = a[~hit]  # no slip before the end of the step: stick, the force keeps loading
+        if len(s):
+            rest = 1.0 - theta[s]
+            F_end = F[s] + (rate[s] * rest)[:, None] * u[s]
+            finish(s, F_end, F_end, rest)
+        h = a[hit]
+        if not len(h):
+            break
+        dth = dtheta[hit]
+        F_hit = F[h] + (rate[h] * dth)[:, None] * u[h]
+        stick[h] += dth
+        theta[h] += dth
+        # E3. The slip: the force drops to Fmin along its direction t (eq. 8).
+        t = F_hit / np.sqrt(_dot(F_hit, F_hit))[:, None]
+        slips[h] += 1
+        F[h] = f_min[h, None] * t + kept[h, None] * u[h]
+        rest = 1.0 - theta[h]
+        # E4. Sliding: the restarted force is at or above T again, so slips follow without
+        # end and turn t onto u: the contact slides at Fmin*u for the rest of the step.
+        slide = (kept[h] > 0) & (_dot(F[h], F[h]) >= T[h] ** 2)
+        # E5. Not moving: the force stays where the slip left it.
+        frozen = ~slide & (rate[h] == 0)
+        # E6. mu_k = mu_s and nothing added at the reset: plastic flow on |F| = T.
+        along = _dot(t, u[h])
+        flow = (~slide & ~frozen & (along > 0)) if flow_law else np.zeros(len(h), bool)
+        if slide.any():
+            i = h[slide]
+            finish(i, (f_min[i] + kept[i])[:, None] * u[i], f_min[i, None] * u[i], 0.0)
+        if frozen.any():
+            i = h[frozen]
+            finish(i, F[i], F[i], rest[frozen])
+        if flow.any():
+            i = h[flow]
+            F_end = _plastic_flow(F[i], u[i], rate[i] * rest[flow] / T[i], T[i])
+            finish(i, F_end, F_end, 0.0)
+        # E7. Settled along u (or followed MAX_EXPLICIT_SLIPS times): the remaining slips
+        # of the step repeat one cycle, (Fmin + kept)*u -> T*u, in closed form.
+        go = ~slide & ~frozen & ~flow
+        if go.any():
+            i = h[go]
+            q = F[i] - _dot(F[i], u[i])[:, None] * u[i]
+            settled = (((np.sqrt(_dot(q, q)) <= SETTLED * T[i]) & (along[go] > 0))
+                       | (slips[i] >= MAX_EXPLICIT_SLIPS))
+            c = i[settled]
+            if len(c):
+                trial, force, slid = _periodic_slips(q[settled], u[c], rate[c], T[c], r, kept[c], f_min[c],
+                                                     rest[go][settled])
+                finish(c, trial, force, np.where(slid, 0.0, rest[go][settled]))
+    # The spring at the end holds the trial force less the dashpot (eq. 5).
+    D_end = -(trial_end + p.nu_s * V_s) / p.ks
+    return applied, D_end, stick
+
+
+def _periodic_slips(q, u, rate, T, r, kept, f_min, rest):
+    """E7: from just after a slip, n whole cycles (Fmin + kept)*u -> T*u, each of length
+    L in theta, then part of one. The part q of the force across u shrinks by r at each
+    slip. Returns the trial and applied force at the end, and which contacts slide."""
+    low = f_min + kept  # the force along u just after a slip
+    L = (T - low) / rate  # rate > 0 here (E5 took the others)
+    # a contact followed MAX_EXPLICIT_SLIPS times whose restart is already at T slides
+    slid = ~(L > 0)
+    L = np.where(slid, 1.0, L)
+    n = np.floor(rest / L)
+    part = rest - n * L
+    trial = np.where(slid[:, None], low[:, None] * u, (low + rate * part)[:, None] * u + (r ** n)[:, None] * q)
+    force = np.where(slid[:, None], f_min[:, None] * u, trial)
+    return trial, force, slid
+
+
+def _plastic_flow(F, u, k_rest, T):
+    """E6: mu_k = mu_s, the force stays on |F| = T and turns towards u. With phi the angle
+    between F and u, d(phi)/d(theta) = -(rate/T) sin(phi), so tan(phi/2) falls as
+    exp(-rate*theta/T): over the rest of the step by the factor exp(-k_rest)."""
+    f = _dot(F, u)
+    q = F - f[:, None] * u
+    qn = np.sqrt(_dot(q, q))
+    s = qn / (T + f) * np.exp(-k_rest)  # tan(phi/2) at the end (f > 0 here)
+    cos, sin = (1.0 - s * s) / (1.0 + s * s), 2.0 * s / (1.0 + s * s)
+    p_hat = np.divide(q, qn[:, None], out=np.zeros_like(q), where=qn[:, None] > 0)
+    return (T * cos)[:, None] * u + (T * sin)[:, None] * p_hat
+
+
+def _dot(a, b):
+    return np.einsum("ij,ij->i", a, b)
 
 
 def _unit(V):
-    mag = np.sqrt(np.einsum("ij,ij->i", V, V))
+    mag = np.sqrt(_dot(V, V))
     return np.divide(V, mag[:, None], out=np.zeros_like(V), where=mag[:, None] > 0), mag
 
 

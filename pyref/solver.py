@@ -33,7 +33,7 @@ class Simulation:
         self.moving_walls = eff["moving_walls"]
         c = s.contact
         self.p = LawParams(c.law, c.kn, c.nu_n if eff["normal_damping"] else 0.0, c.ks,
-                           c.nu_s if eff["tangential_damping"] else 0.0, c.mu_s, c.mu_k, c.reset)
+                           c.nu_s if eff["tangential_damping"] else 0.0, c.mu_s, c.mu_k, c.reset, c.slip_timing)
 
         g = s.grains
         self.N = len(g)
@@ -204,11 +204,11 @@ class Simulation:
                 pos = np.minimum(np.searchsorted(sorted_keys, key), len(sorted_keys) - 1)
                 old = sorted_keys[pos] == key
                 D[old] = rotate_history(self.D[order[pos[old]]], n[old])
-        D_prev = D
-        F_s, D, slipped = tangential_force(D, V_s, fn, dt, self.p)
+        tan = tangential_force(D, V_s, fn, dt, self.p, energy=self.energy)
+        F_s, D, slipped = tan.force, tan.spring, tan.slipped
 
         if self.energy and len(key):
-            self._account_contact_energy(fn, delta, v_n, F_s, V_s, D_prev, D, dt)
+            self._account_contact_energy(fn, delta, v_n, tan, dt)
 
         self.keys, self.D = key, D
         self.slip_steps += int(slipped.sum())
@@ -228,14 +228,12 @@ class Simulation:
             f += self.m[:, None] * self.g
         return f, torque
 
-    def _account_contact_energy(self, fn, delta, v_n, F_s, V_s, D_prev, D, dt):
+    def _account_contact_energy(self, fn, delta, v_n, tan, dt):
         """Energy each contact took out this step. Normal: the non-elastic part of the
-        force times the approach, (Fn - Kn*delta)*v_n*dt. Tangential: work received,
-        -F_s.V_s*dt, minus the increase of the spring's energy 1/2 Ks |D|^2."""
+        force times the approach, (Fn - Kn*delta)*v_n*dt. Tangential: the law's own
+        account (dashpot + slips = work received less the spring's gain, docs/law.md)."""
         e_n = (fn - self.p.kn * delta) * v_n * dt
-        e_t = -_dot(F_s, V_s) * dt
-        if self.p.has_spring:
-            e_t = e_t - 0.5 * self.p.ks * (_dot(D, D) - _dot(D_prev, D_prev))
+        e_t = tan.dissipated_dashpot + tan.dissipated_slip
         self.last_e_t = e_t
         self.e_diss += float(e_n.sum() + e_t.sum())
 

@@ -17,6 +17,7 @@ import numpy as np
 CASES_DIR = Path(__file__).resolve().parent.parent / "cases"
 LAWS = ("stick_slip", "visco_elastic", "visco_plastic", "coulomb")
 RESETS = ("spring", "total")
+SLIP_TIMINGS = ("step", "exact")
 EFFECTS = ("gravity", "rotation", "normal_damping", "tangential_damping", "moving_walls")
 ANALYSES = ("none", "drag", "tray", "tilt")
 
@@ -35,6 +36,7 @@ class Contact:
     mu_s: float
     mu_k: float
     reset: str = "spring"
+    slip_timing: str = "step"  # step (the paper, literally) | exact (docs/law.md)
 
 
 @dataclass
@@ -310,9 +312,10 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
         mu_s=ct.number("mu_s", required=True, lo=0, lo_open=True),
         mu_k=ct.number("mu_k", required=True, lo=0),
         reset=ct.string("reset", "spring", RESETS),
+        slip_timing=ct.string("slip_timing", "step", SLIP_TIMINGS),
     )
     ct.done()
-    for k in ("kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k", "reset"):
+    for k in ("kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k", "reset", "slip_timing"):
         if k in overrides:
             setattr(contact, k, overrides.pop(k))
     check_contact(contact)
@@ -432,6 +435,8 @@ def check_contact(c: Contact) -> None:
         raise SceneError(f"contact.mu_k = {c.mu_k:g}: must be >= 0")
     if c.reset not in RESETS:
         raise SceneError(f"contact.reset = {c.reset!r}: must be one of {', '.join(RESETS)}")
+    if c.slip_timing not in SLIP_TIMINGS:
+        raise SceneError(f"contact.slip_timing = {c.slip_timing!r}: must be one of {', '.join(SLIP_TIMINGS)}")
 
 
 def _axes(t: _Table, k, dim):
