@@ -1,13 +1,14 @@
 """`stickslip bench`: performance figures, measured side by side in one run.
 
 Every figure is a median over repetitions; ratios compare runs made in the same
-process, one after the other. Engines that provide `benchmark(reps)` in their
-adapter add their own rows (LIGGGHTS plugin overhead and MPI speed-up, YADE law
+process, one after the other. Engines with a module `stickslip/adapters/<engine>_bench.py`
+providing `benchmark(reps)` add their own rows (LIGGGHTS plugin overhead and MPI speed-up, YADE law
 cost per contact-step).
 """
 from __future__ import annotations
 
 import csv
+import importlib
 import math
 import statistics
 import time
@@ -152,9 +153,11 @@ def run_bench(out: Path, reps=3, engines=None):
     rows = pyref_rows(reps) + effect_rows(reps)
     ok, missing = adapters.available()
     for eng in [e for e in ok if e != "pyref" and (engines is None or e in engines)]:
-        adapter = adapters.get(eng)
-        if hasattr(adapter, "benchmark"):
-            rows += adapter.benchmark(reps)
+        try:
+            engine_bench = importlib.import_module(f"stickslip.adapters.{eng}_bench")
+        except ModuleNotFoundError:
+            continue
+        rows += engine_bench.benchmark(reps)
     fields = ["benchmark", "case", "contacts", "seconds_per_step", "contact_steps_per_s", "ratio_to_all_on", "value"]
     with open(out / "bench.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
@@ -168,7 +171,7 @@ def run_bench(out: Path, reps=3, engines=None):
     for e, why in missing.items():
         lines.append(f"\n{e}: not measured ({why})")
     if any(r["benchmark"] == "liggghts" for r in rows):
-        from .liggghts_bench import SCALING_NOTE
+        from .adapters.liggghts_bench import SCALING_NOTE
         lines += ["", SCALING_NOTE]
     (out / "bench.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))

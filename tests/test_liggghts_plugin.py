@@ -27,9 +27,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from stickslip.adapters.liggghts import LAUNCHER, PRELOAD
+
 ROOT = Path(__file__).resolve().parent.parent
-LAUNCHER = ROOT / "build" / "liggghts_plugin" / "liggghts-stickslip"
-PRELOAD = ROOT / "build" / "liggghts_plugin" / "libstickslip_liggghts.so"
 TEMPLATES = Path(__file__).resolve().parent / "liggghts"
 STOCK = shutil.which("liggghts")
 EPS = np.finfo(float).eps

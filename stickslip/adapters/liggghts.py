@@ -23,7 +23,10 @@ from . import RunResult
 
 NAME = "liggghts"
 REPO = Path(__file__).resolve().parents[2]
-LAUNCHER = REPO / "build" / "liggghts_plugin" / "liggghts-stickslip"
+# The plugin build (./run.sh setup): the launcher and the preloadable library. Defined here only.
+BUILD = REPO / "build" / "liggghts_plugin"
+LAUNCHER = BUILD / "liggghts-stickslip"
+PRELOAD = BUILD / "libstickslip_liggghts.so"
 # contact history layout of the stick_slip model with the record on (1-based, as LIGGGHTS counts):
 # D (3 values), then Fn, F_s (3), cumulative slip count
 RECORD_FN, RECORD_FS, RECORD_NSLIP = 4, 5, 8
@@ -91,6 +94,8 @@ class _Script:
         settings = "absolute_damping on limitForce on stick_slip_record on"
         if c.reset == "total":
             settings += " slip_reset_total on"
+        if c.slip_timing == "exact":
+            settings += " exact_slip_timing on"
         return model, settings
 
     def _mesh_file(self, w, half):
@@ -353,11 +358,3 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
         raise RuntimeError(f"LIGGGHTS failed (exit {p.returncode}); see {work / 'screen.txt'}")
     df = _timeseries(script, work)
     return RunResult(df, scene.steps, sum(loop) if loop else time.perf_counter() - t0)
-
-
-def benchmark(reps=3):
-    """Rows for `stickslip bench`: the plugin's overhead against stock `tangential
-    history` and the MPI speed-up on 20 800 spheres (stickslip/liggghts_bench.py)."""
-    from ..liggghts_bench import benchmark as liggghts_benchmark
-
-    return liggghts_benchmark(reps)

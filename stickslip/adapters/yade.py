@@ -44,7 +44,7 @@ def scene_dict(scene):
     return {
         "dimension": scene.dimension, "effects": scene.effects, "gravity": v(scene.gravity),
         "contact": {"kn": c.kn, "nu_n": c.nu_n, "ks": c.ks, "nu_s": c.nu_s, "mu_s": c.mu_s, "mu_k": c.mu_k,
-                    "reset": c.reset},
+                    "reset": c.reset, "slip_timing": c.slip_timing},
         "dt": scene.dt, "steps": scene.steps, "every": scene.output.every,
         "grains": [{"name": g.name, "radius": g.radius, "mass": scene.grain_mass(g),
                     "inertia": scene.grain_inertia(g), "position": v(g.position), "velocity": v(g.velocity),
@@ -83,27 +83,3 @@ def run(scene, out_dir, progress=None):
         raise RuntimeError(f"yade failed (exit {p.returncode}); see {work / 'yade.log'}")
     df = pd.read_csv(csv_path)
     return RunResult(df, scene.steps, wall if wall is not None else time.perf_counter() - t0)
-
-
-def benchmark(reps=3):
-    """Rows for `stickslip bench`: yade_law/bench_yade_law.py (>= 20 000 contacts), the
-    Python law's cost per contact-step against the native frictional law, same run."""
-    rows = []
-    for rotation in (True, False):
-        args = ["yade", "-n", "-x", str(RUNNER.parent / "bench_yade_law.py"), "--reps", str(reps)]
-        if not rotation:
-            args.append("--no-rotation")
-        p = subprocess.run(args, capture_output=True, text=True, timeout=3600, cwd=RUNNER.parent)
-        got = [x for x in p.stdout.splitlines() if x.startswith("RESULT ")]
-        if p.returncode != 0 or not got:
-            raise RuntimeError(f"yade benchmark failed (exit {p.returncode}): {p.stderr.strip()[-300:]}")
-        r = json.loads(got[-1][7:])
-        rot = "rotation on" if rotation else "rotation off"
-        for case, key in (("stick-slip law (PyRunner), us per contact-step", "law_us"),
-                          ("native InteractionLoop (Ig2 + frictional Law2), us per contact-step", "native_loop_us"),
-                          ("ratio law / native InteractionLoop", "ratio"),
-                          ("whole step, native frictional, us per contact-step", "step_native_us"),
-                          ("whole step, stick-slip, us per contact-step", "step_stickslip_us")):
-            rows.append({"benchmark": "yade", "case": f"{case} ({rot})", "contacts": r["contacts"],
-                         "value": r[key]})
-    return rows

@@ -22,7 +22,7 @@ re-run (within a budget of 2 x reps re-runs), and the worst remaining figure is 
 Cost on the 2-core reference machine: ~3.5 min for benchmark(3) with the packing cached,
 ~2 min more to make it (40 000 steps on 2 processes).
 
-    python -m stickslip.liggghts_bench [--reps 3]
+    python -m stickslip.adapters.liggghts_bench [--reps 3]
 """
 from __future__ import annotations
 
@@ -38,9 +38,9 @@ import tempfile
 import time
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
-LAUNCHER = REPO / "build" / "liggghts_plugin" / "liggghts-stickslip"
-CACHE = REPO / "build" / "liggghts_bench"
+from .liggghts import BUILD, LAUNCHER
+
+CACHE = BUILD.parent / "liggghts_bench"
 
 STEPS = 3000  # timed steps per run (~20 s on one core of the reference machine)
 WARM = 200  # untimed steps first: contact histories build up again after read_data
@@ -381,7 +381,7 @@ def _table(rows):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m stickslip.liggghts_bench",
+    ap = argparse.ArgumentParser(prog="python -m stickslip.adapters.liggghts_bench",
                                  description="LIGGGHTS stick_slip plugin: overhead vs stock history, MPI speed-up.")
     ap.add_argument("--reps", type=int, default=3, help="repetitions per figure (median quoted)")
     a = ap.parse_args(argv)
