@@ -8,6 +8,8 @@ velocity of i's contact point relative to j's, so friction opposes it.
 """
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -38,10 +40,35 @@ class LawParams:
     reset: str = "spring"  # spring (eq. 8 read literally) | total
     slip_timing: str = "step"  # step (the paper: slip tested at the end of the step) | exact
 
+    def __post_init__(self):
+        self.check()
+
     @property
     def has_spring(self) -> bool:
         """Laws that keep a tangential history (a spring elongation D per contact)."""
         return self.law in ("stick_slip", "visco_elastic")
+
+    def check(self) -> None:
+        """The parameter rules of docs/law.md: ValueError naming the parameter and its
+        allowed range (the one checker of the Python engines; scenes prefix "contact.")."""
+        for name, allowed in (("law", LAWS), ("reset", RESETS), ("slip_timing", SLIP_TIMINGS)):
+            v = getattr(self, name)
+            if v not in allowed:
+                raise ValueError(f"{name} = {v!r}: must be one of {', '.join(allowed)}")
+        for name in ("kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+                raise ValueError(f"{name} = {v!r}: must be a finite number")
+        positive = ("kn", "mu_s") + (("ks",) if self.has_spring else ())
+        for name in ("kn", "ks", "mu_s", "nu_n", "nu_s", "mu_k"):
+            v = float(getattr(self, name))
+            if name in positive and not v > 0:
+                raise ValueError(f"{name} = {v:g}: must be > 0")
+            if v < 0:
+                raise ValueError(f"{name} = {v:g}: must be >= 0")
+        if self.law == "stick_slip" and not self.mu_s / 2 <= self.mu_k <= self.mu_s:
+            raise ValueError(f"mu_k = {self.mu_k:g}: must be in [mu_s/2, mu_s] = [{self.mu_s / 2:g}, {self.mu_s:g}] "
+                             f"so that 0 <= Fmin = (2 mu_k - mu_s) Fn <= mu_k Fn")
 
 
 class TangentialStep(NamedTuple):
@@ -51,6 +78,13 @@ class TangentialStep(NamedTuple):
     slipped: np.ndarray  # (K,) bool: at least one slip during the step
     dissipated_dashpot: np.ndarray | None  # (K,) energy the dashpot took (energy=True)
     dissipated_slip: np.ndarray | None  # (K,) energy the slips took (energy=True)
+
+
+def every_step_slips_speed(p: LawParams, fn, dt):
+    """Step timing: the sliding speed above which every step slips. After a slip the
+    spring holds Fmin (eq. 8); one step later the trial force is Fmin + (Ks*dt + nu_s)*V,
+    so every step slips once V >= 2(mu_s - mu_k)Fn/(Ks*dt + nu_s) (docs/precision.md)."""
+    return 2 * (p.mu_s - p.mu_k) * fn / (p.ks * dt + p.nu_s)
 
 
 def normal_force(delta, v_n, p: LawParams):

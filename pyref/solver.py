@@ -9,10 +9,11 @@ from __future__ import annotations
 
 import math
 import time
+from typing import NamedTuple
 
 import numpy as np
 
-from .laws import LawParams, normal_force, rotate_history, tangential_force
+from .laws import normal_force, rotate_history, tangential_force
 
 PAIR_BRUTE_FORCE_MAX = 64  # below this many grains, test every pair (no tree)
 
@@ -21,8 +22,44 @@ def _dot(a, b):
     return np.einsum("ij,ij->i", a, b)
 
 
+class Contacts(NamedTuple):
+    """The touching contacts of the last force evaluation, one row each."""
+    i: np.ndarray  # grain index
+    j: np.ndarray  # grain index, or N + wall index
+    key: np.ndarray  # i*(N+W) + j, the contact's identity
+    n: np.ndarray  # (K, 3) unit normal from i to j
+    fn: np.ndarray  # normal force magnitude
+    force: np.ndarray  # (K, 3) tangential force on i
+    slipped: np.ndarray  # bool: slipped during the last step
+    delta: np.ndarray  # overlap
+
+
+class Recording(NamedTuple):
+    """What a run recorded, one row every `output.every` steps (and the start). Grains,
+    contacts and walls in the order the scene's [output] names them; `dim` components."""
+    t: np.ndarray  # (R,)
+    x: np.ndarray  # (R, G, dim) positions
+    v: np.ndarray  # (R, G, dim) velocities
+    w: np.ndarray | None  # (R, G, 1 in 2D or 3) spins, None without rotation
+    fn: np.ndarray  # (R, C) normal force of each recorded contact (0: not touching)
+    ft: np.ndarray  # (R, C, dim) tangential force on the contact's first grain
+    slips: np.ndarray  # (R, C) steps with a slip since the previous row
+    angle: np.ndarray  # (R, Wr) angle of each recorded wall
+    n_contacts: np.ndarray | None  # (R,) with output.stats
+    ekin: np.ndarray | None  # (R,) with output.stats
+    energy: dict | None  # name -> (R,) with output.energy (ENERGY_FIELDS)
+    steps: int
+    wall_time_s: float
+
+
+# Energy books (output.energy): kinetic, elastic (normal + tangential springs),
+# dissipated (all contact losses; of which the tangential law's slips and dashpot),
+# work done by gravity and by imposed velocities / moving walls.
+ENERGY_FIELDS = ("e_kin", "e_elastic", "e_dissipated", "e_slip", "e_dashpot", "w_gravity", "w_drive")
+
+
 class Simulation:
-    def __init__(self, scene, record=True, energy=False):
+    def __init__(self, scene, record=True, energy=None):
         self.scene = scene
         s = scene
         self.dim = s.dimension
@@ -31,9 +68,7 @@ class Simulation:
         self.gravity_on = eff["gravity"]
         self.rotation_on = eff["rotation"]
         self.moving_walls = eff["moving_walls"]
-        c = s.contact
-        self.p = LawParams(c.law, c.kn, c.nu_n if eff["normal_damping"] else 0.0, c.ks,
-                           c.nu_s if eff["tangential_damping"] else 0.0, c.mu_s, c.mu_k, c.reset, c.slip_timing)
+        self.p = s.contact.law_params(eff)
 
         g = s.grains
         self.N = len(g)
@@ -66,8 +101,11 @@ class Simulation:
         self.x_at_build = None
         self.skin = 0.2 * float(self.r.min())
 
-        self.energy = energy
+        # energy books: when the scene records them, or when asked (tests)
+        self.energy = s.output.energy if energy is None else energy
         self.e_diss = 0.0  # energy taken out by the contact laws (dashpots, slips, clipping)
+        self.e_slip = 0.0  # of which the tangential law's slips
+        self.e_dashpot = 0.0  # and its dashpot
         self.w_grav = 0.0  # work of gravity
         self.w_drive = 0.0  # work of imposed velocities and moving walls
         self.names = {q.name: i for i, q in enumerate(g)}
@@ -212,7 +250,7 @@ class Simulation:
 
         self.keys, self.D = key, D
         self.slip_steps += int(slipped.sum())
-        self.last = (i, j, key, n, fn, F_s, slipped, delta)
+        self.contacts = Contacts(i, j, key, n, fn, F_s, slipped, delta)
 
         F = -fn[:, None] * n + F_s
         jg = j[grain_j]
@@ -235,6 +273,8 @@ class Simulation:
         e_n = (fn - self.p.kn * delta) * v_n * dt
         e_t = tan.dissipated_dashpot + tan.dissipated_slip
         self.last_e_t = e_t
+        self.e_slip += float(tan.dissipated_slip.sum())
+        self.e_dashpot += float(tan.dissipated_dashpot.sum())
         self.e_diss += float(e_n.sum() + e_t.sum())
 
     # ------------------------------------------------------------ integration
@@ -283,7 +323,7 @@ class Simulation:
     def _account_wall_work(self):
         """Work of moving walls on the grains: contact force on the grain times the
         wall's velocity at the contact point, over the step."""
-        i, j, _, n, fn, F_s, _, delta = self.last
+        i, j, _, n, fn, F_s, _, delta = self.contacts
         on_wall = j >= self.N
         if on_wall.any():
             _, _, rates = self._wall_state()
@@ -301,8 +341,7 @@ class Simulation:
         return e
 
     def elastic_energy(self):
-        i, j, key, n, fn, F_s, slipped, delta = self.last
-        e = 0.5 * self.p.kn * float(np.sum(delta**2))
+        e = 0.5 * self.p.kn * float(np.sum(self.contacts.delta**2))
         if self.p.has_spring:
             e += 0.5 * self.p.ks * float(np.sum(self.D * self.D))
         return e
@@ -312,34 +351,19 @@ class Simulation:
         out = self.scene.output
         self.rec_grains = [self.names[g] for g in out.grains]
         NW = self.N + self.W
-        self.rec_contacts = [(a, b, "-".join(p)) for p in out.contacts
-                             for a, b in [(self.names[p[0]], self.names[p[1]])]]
+        pairs = [(self.names[a], self.names[b]) for a, b in out.contacts]
         # A contact a-b is stored with i < j for grain pairs; remember the sign.
         self.rec_keys = np.array([min(a, b) * NW + max(a, b) if b < self.N else a * NW + b
-                                  for a, b, _ in self.rec_contacts], np.int64)
-        self.rec_sign = np.array([1.0 if (b >= self.N or a < b) else -1.0 for a, b, _ in self.rec_contacts])
-        self.rec_slips = np.zeros(len(self.rec_contacts), np.int64)
+                                  for a, b in pairs], np.int64)
+        self.rec_sign = np.array([1.0 if (b >= self.N or a < b) else -1.0 for a, b in pairs])
+        self.rec_slips = np.zeros(len(pairs), np.int64)
+        self.rec_walls = [k for k, w in enumerate(self.walls) if w.name in out.walls]
         self.rows = []
-        self.columns = ["t"]
-        axes = "xyz"[: self.dim]
-        for gi in self.rec_grains:
-            nm = self.scene.grains[gi].name
-            self.columns += [f"{nm}_{a}" for a in axes] + [f"{nm}_v{a}" for a in axes]
-            if self.rotation_on:
-                self.columns += [f"{nm}_wz"] if self.dim == 2 else [f"{nm}_w{a}" for a in axes]
-        for _, _, c in self.rec_contacts:
-            self.columns += [f"{c}_fn", f"{c}_fs"] + [f"{c}_ft{a}" for a in axes] + [f"{c}_slip"]
-        self.rec_walls = [k for k, w in enumerate(self.walls) if w.name in self.scene.output.walls]
-        self.columns += [f"{self.walls[k].name}_angle" for k in self.rec_walls]
-        if self.scene.output.stats:
-            self.columns += ["n_contacts", "ekin"]
-        if self.energy:
-            self.columns += ["e_kin", "e_elastic", "e_dissipated", "w_gravity", "w_drive"]
 
     def _count_slips(self):
         if not len(self.rec_keys):
             return
-        key, slipped = self.last[2], self.last[6]
+        key, slipped = self.contacts.key, self.contacts.slipped
         if not slipped.any():
             return
         order = np.argsort(key)
@@ -347,52 +371,70 @@ class Simulation:
         hit = key[order][pos] == self.rec_keys
         self.rec_slips[hit] += slipped[order][pos[hit]]
 
-    def _row(self):
-        t = self.step_no * self.dt
-        row = [t]
-        d = self.dim
-        for gi in self.rec_grains:
-            row += list(self.x[gi, :d]) + list(self.v[gi, :d])
-            if self.rotation_on:
-                row += [self.w[gi, 2]] if d == 2 else list(self.w[gi])
-        i, j, key, n, fn, F_s, slipped, delta = self.last
-        lookup = {int(k): idx for idx, k in enumerate(key)} if len(self.rec_keys) else {}
-        for c, k in enumerate(self.rec_keys):
-            idx = lookup.get(int(k))
-            if idx is None:
-                row += [0.0, 0.0] + [0.0] * d + [int(self.rec_slips[c])]
-            else:
-                ft = F_s[idx] * self.rec_sign[c]
-                row += [fn[idx], float(np.linalg.norm(ft))] + list(ft[:d]) + [int(self.rec_slips[c])]
+    def record_row(self):
+        """One row of the Recording (see there), as a tuple of arrays."""
+        d, g = self.dim, self.rec_grains
+        C = len(self.rec_keys)
+        fn, ft = np.zeros(C), np.zeros((C, d))
+        if C:
+            c = self.contacts
+            lookup = {int(k): idx for idx, k in enumerate(c.key)}
+            for r, k in enumerate(self.rec_keys):
+                idx = lookup.get(int(k))
+                if idx is not None:
+                    fn[r], ft[r] = c.fn[idx], c.force[idx, :d] * self.rec_sign[r]
+        spin = None
+        if self.rotation_on:
+            spin = self.w[g][:, 2:] if d == 2 else self.w[g]
+        row = (self.step_no * self.dt, self.x[g, :d].copy(), self.v[g, :d].copy(), spin, fn, ft,
+               self.rec_slips.copy(), [self.wall_angle(k) for k in self.rec_walls])
         self.rec_slips[:] = 0
-        row += [self.wall_angle(k) for k in self.rec_walls]
-        if self.scene.output.stats:
-            row += [len(key), self.kinetic_energy()]
+        stats = (len(self.contacts.key), self.kinetic_energy()) if self.scene.output.stats else None
+        energy = None
         if self.energy:
-            row += [self.kinetic_energy(), self.elastic_energy(), self.e_diss, self.w_grav, self.w_drive]
-        self.rows.append(row)
+            energy = (self.kinetic_energy(), self.elastic_energy(), self.e_diss, self.e_slip, self.e_dashpot,
+                      self.w_grav, self.w_drive)
+        self.rows.append(row + (stats, energy))
+
+    def recording(self, steps=None, wall_time_s=0.0) -> Recording:
+        """The rows recorded so far (record_row), as a Recording."""
+        rows = self.rows
+        R, G, C, d = len(rows), len(self.rec_grains), len(self.rec_keys), self.dim
+        col = lambda k, shape: np.array([r[k] for r in rows], float).reshape((R,) + shape)  # noqa: E731
+        stats = self.scene.output.stats
+        return Recording(
+            t=col(0, ()), x=col(1, (G, d)), v=col(2, (G, d)),
+            w=col(3, (G, 1 if d == 2 else 3)) if self.rotation_on else None,
+            fn=col(4, (C,)), ft=col(5, (C, d)), slips=col(6, (C,)).astype(np.int64),
+            angle=col(7, (len(self.rec_walls),)),
+            n_contacts=np.array([r[8][0] for r in rows], np.int64) if stats else None,
+            ekin=np.array([r[8][1] for r in rows]) if stats else None,
+            energy={f: np.array([r[9][k] for r in rows]) for k, f in enumerate(ENERGY_FIELDS)}
+            if self.energy else None,
+            steps=self.step_no if steps is None else steps, wall_time_s=wall_time_s)
 
     # ------------------------------------------------------------ driver
-    def run(self, steps=None, progress=None):
-        """Run the scene; returns (columns, rows, steps, wall_time_s)."""
+    def run(self, steps=None, progress=None) -> Recording:
+        """Run the scene (or `steps` steps of it); returns the Recording."""
         steps = self.scene.steps if steps is None else steps
         every = self.scene.output.every
         t0 = time.perf_counter()
         if self.record:
-            self._row()
+            self.record_row()
         for k in range(steps):
             self.step()
             if self.record:
                 self._count_slips()
                 if self.step_no % every == 0:
-                    self._row()
+                    self.record_row()
             if progress is not None and k % 2000 == 0:
                 progress(k, steps)
-            if not np.isfinite(self.x).all():
-                raise FloatingPointError(f"non-finite position at step {self.step_no} (t = {self.step_no * self.dt:g} s)")
+            if not (np.isfinite(self.x).all() and np.isfinite(self.v).all()):
+                raise FloatingPointError(f"non-finite position or velocity at step {self.step_no} "
+                                         f"(t = {self.step_no * self.dt:g} s)")
         if progress is not None:
             progress(steps, steps)
-        return self.columns, self.rows, steps, time.perf_counter() - t0
+        return self.recording(steps, time.perf_counter() - t0)
 
 
 def _cross(a, b):

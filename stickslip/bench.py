@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import csv
 import importlib
-import math
 import statistics
 import time
 import tracemalloc
@@ -80,7 +79,7 @@ def time_steps(sc, steps, reps, warm=5):
         n = 0
         for _ in range(steps):
             sim.step()
-            n += len(sim.last[2])
+            n += len(sim.contacts.key)
         times.append((time.perf_counter() - t0) / steps)
         contacts.append(n / steps)
     return statistics.median(times), float(np.mean(contacts))

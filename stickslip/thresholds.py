@@ -16,6 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
+from pyref.laws import every_step_slips_speed
+
+from . import plotstyle
 from . import scene as scene_mod
 
 DTS = (1e-6, 4e-6, 1.6e-5)
@@ -23,8 +26,10 @@ NU_S = (0.0, 33.10, 100.0)
 
 
 def formula(sc, dt, nu_s, fn):
-    p = sc.contact
-    return 2 * (p.mu_s - p.mu_k) * fn / (p.ks * dt + nu_s)
+    """V* for the scene's law with tangential damping nu_s (pyref.laws.every_step_slips_speed)."""
+    p = sc.contact.law_params(dict(sc.effects, tangential_damping=True))
+    p.nu_s = nu_s
+    return every_step_slips_speed(p, fn, dt)
 
 
 def every_step_slips(base, dt, nu_s, speed, after_first=40):
@@ -86,11 +91,7 @@ def run_thresholds(out: Path, dts=DTS, nus=NU_S):
 
 
 def _plot(rows, path):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = plotstyle.pyplot()
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     for nu, mark in zip(sorted({r["nu_s"] for r in rows}), "os^"):
         rr = [r for r in rows if r["nu_s"] == nu]
@@ -101,6 +102,4 @@ def _plot(rows, path):
     ax.set_ylabel("speed above which every step slips (m/s)")
     ax.set_title("V* = 2(mu_s - mu_k)Fn / (Ks dt + nu_s)  (grey: formula)")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    plotstyle.save(fig, path.parent, path.name, dpi=110)

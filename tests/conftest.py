@@ -2,12 +2,12 @@ import functools
 import sys
 from pathlib import Path
 
-import pandas as pd
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from stickslip import columns  # noqa: E402
 from stickslip import scene as scene_mod  # noqa: E402
 from pyref import Simulation  # noqa: E402
 
@@ -27,9 +27,10 @@ def pytest_collection_modifyitems(config, items):
 
 def run_pyref(sc, energy=False):
     """Run a scene on pyref; returns (timeseries DataFrame, Simulation)."""
-    sim = Simulation(sc, energy=energy)
-    columns, rows, _, _ = sim.run()
-    return pd.DataFrame(rows, columns=columns), sim
+    if energy:
+        sc.output.energy = True
+    sim = Simulation(sc)
+    return columns.frame(sc, sim.run()), sim
 
 
 def paper_case(name, law=None, duration=None):

@@ -5,6 +5,7 @@ import tomllib
 import numpy as np
 import pytest
 
+from stickslip import columns
 from stickslip import scene as scene_mod
 from pyref import Simulation
 
@@ -55,11 +56,13 @@ normal = [-1.0, 0.0]
 
 def pour(nx, ny, duration, dt=5e-6):
     width = 0.003 + nx * 2 * 0.002 * 1.2 * 1.05 + 0.001
-    return scene_mod.parse(tomllib.loads(POUR.format(nx=nx, ny=ny, duration=duration, dt=dt, width=width)))
+    sc = scene_mod.parse(tomllib.loads(POUR.format(nx=nx, ny=ny, duration=duration, dt=dt, width=width)))
+    sc.output.energy = True
+    return sc
 
 
 def settle(sc):
-    sim = Simulation(sc, record=True, energy=True)
+    sim = Simulation(sc, record=True)
     worst_e_t = 0.0
     ekin = []
     for k in range(sc.steps):
@@ -70,7 +73,7 @@ def settle(sc):
             worst_e_t = min(worst_e_t, float(e_t.min()))
         if k % 200 == 0:
             ekin.append(sim.kinetic_energy())
-            sim._row()
+            sim.record_row()
     return sim, np.array(ekin), worst_e_t
 
 
@@ -80,9 +83,7 @@ def check(sc, sim, ekin, worst_e_t):
     # The pile comes to rest: kinetic energy falls to under 1 % of its peak.
     assert ekin[-1] < 0.01 * ekin.max()
     # Energy balance within omega*dt (tests/test_pyref_energy.py explains the bound).
-    import pandas as pd
-
-    df = pd.DataFrame(sim.rows, columns=sim.columns)
+    df = columns.frame(sc, sim.recording())
     total = df.e_kin + df.e_elastic + df.e_dissipated - df.w_gravity - df.w_drive
     scale = max(df.e_dissipated.abs().max(), df.w_gravity.abs().max())
     assert (total - total.iloc[0]).abs().max() / scale <= 2 * sc.dt / sc.critical_dt()

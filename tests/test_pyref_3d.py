@@ -57,7 +57,7 @@ def test_turntable_force_in_tangent_plane_and_against_sliding():
     worst = 0.0
     slips = 0
     for s in steps(sim, sc.steps - 1):
-        i, j, key, n, fn, F_s, slipped, delta = s.last
+        i, j, key, n, fn, F_s, slipped, delta = s.contacts
         assert len(key) == 1
         f = F_s[0]
         assert abs(f @ n[0]) <= 1e-12 * np.linalg.norm(f)  # in the tangent plane
@@ -114,7 +114,7 @@ imposed = ["x", "y", "z"]
     seen = 0
     turned = []
     for s in steps(sim, sc.steps):
-        i, j, key, n, fn, F_s, slipped, delta = s.last
+        i, j, key, n, fn, F_s, slipped, delta = s.contacts
         if len(key):
             seen += 1
             turned.append(n[0].copy())
@@ -189,7 +189,7 @@ normal = [0.0, 0.0, 1.0]
     for _ in range(sc.steps):
         a.step()
         b.step()
-        slips += int(a.last[6].sum())
+        slips += int(a.contacts.slipped.sum())
     assert slips > 0 and a.slip_steps == b.slip_steps
     # Round-off only: positions agree to 1e-9 of a radius, velocities to 1e-9 of 0.3 m/s.
     assert np.allclose(b.x, a.x @ Q.T, atol=5e-12, rtol=0)

@@ -76,7 +76,7 @@ def run_checked(sc, steps=None, every_step=None):
     mu_s = sc.contact.mu_s if sc.contact.law == "stick_slip" else sc.contact.mu_k
     for _ in range(steps or sc.steps):
         sim.step()
-        i, j, key, n, fn, F_s, slipped, delta = sim.last
+        i, j, key, n, fn, F_s, slipped, delta = sim.contacts
         assert np.isfinite(sim.x).all() and np.isfinite(sim.v).all()
         if len(key):
             fs = np.sqrt(np.einsum("ij,ij->i", F_s, F_s))
@@ -123,7 +123,7 @@ def bounce_energy_gain(omega_dt, impacts=40):
     e0, n, touching = energy(), 0, False
     while n < impacts:
         sim.step()
-        now = len(sim.last[2]) > 0
+        now = len(sim.contacts.key) > 0
         if touching and not now:
             n += 1
         touching = now
@@ -164,7 +164,7 @@ def test_plain_slider_and_zero_fmin(mu_k, mean):
     ratios, slips = [], []
     for _ in range(sc.steps):
         sim.step()
-        fn, F_s, slipped = sim.last[4], sim.last[5], sim.last[6]
+        fn, F_s, slipped = sim.contacts.fn, sim.contacts.force, sim.contacts.slipped
         ratios.append(np.linalg.norm(F_s[0]) / fn[0])
         slips.append(bool(slipped[0]))
     idx = np.nonzero(slips)[0]
@@ -180,7 +180,7 @@ def test_contact_opening_while_sliding():
     sc = make(vel=[0.01, 0.0], imposed=["x"], height=0.005 - 2e-5, nu_n=0.0, duration=0.02, dt=2e-6)
 
     def check(sim):
-        i, j, key, n, fn, F_s, slipped, delta = sim.last
+        i, j, key, n, fn, F_s, slipped, delta = sim.contacts
         if len(key) and fn[0] == 0.0:
             assert np.all(F_s[0] == 0.0)
 
@@ -198,7 +198,7 @@ def test_sliding_direction_reversing():
         if k and k % 1000 == 0:
             sim.v_imposed[0, 0] *= -1
         sim.step()
-        fn, F_s = sim.last[4], sim.last[5]
+        fn, F_s = sim.contacts.fn, sim.contacts.force
         assert np.linalg.norm(F_s[0]) <= 0.5 * fn[0] * (1 + 1e-12)
         fx.append(F_s[0, 0])
     fx = np.array(fx)
@@ -270,7 +270,7 @@ def test_sustained_slide_mean_friction_does_not_drift():
     ratios = np.empty(sc.steps)
     for k in range(sc.steps):
         sim.step()
-        ratios[k] = np.linalg.norm(sim.last[5][0]) / sim.last[4][0]
+        ratios[k] = np.linalg.norm(sim.contacts.force[0]) / sim.contacts.fn[0]
     tenth = sc.steps // 10
     a, b = ratios[tenth:2 * tenth].mean(), ratios[-tenth:].mean()
     assert a == pytest.approx(b, rel=1e-3)

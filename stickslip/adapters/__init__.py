@@ -1,12 +1,18 @@
 """Engine adapters: each turns a validated scene into the standard time series.
 
-See docs/adapters.md for the contract. `get(name)` imports an adapter lazily, so
-an engine that is not installed costs nothing until it is asked for.
+An adapter is a module `stickslip/adapters/<engine>.py` that satisfies `Adapter`
+(docs/adapters.md quotes it). It knows only its engine and the scene; it never
+computes headline figures (stickslip/analysis.py does, for every engine alike).
+`get(name)` imports an adapter lazily, so an engine that is not installed costs
+nothing until it is asked for. Engine tooling (benchmarks) sits beside it as
+`<engine>_bench.py`.
 """
 from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Protocol
 
 import pandas as pd
 
@@ -15,13 +21,29 @@ ENGINES = ("pyref", "liggghts", "yade")
 
 @dataclass
 class RunResult:
-    timeseries: pd.DataFrame
+    timeseries: pd.DataFrame  # the columns of stickslip/columns.py, one row every output.every steps
     steps: int
-    wall_time_s: float
-    notes: list = field(default_factory=list)
+    wall_time_s: float  # the engine's own run time, without post-processing
+    notes: list = field(default_factory=list)  # warnings to pass on to the user
 
 
-def get(name):
+class Adapter(Protocol):
+    """What `stickslip.runner.run_scene` calls. An adapter must implement `available`
+    and `run`; everything else (files, processes) is its own business."""
+
+    NAME: str
+
+    def available(self) -> str | None:
+        """None if the engine can run here, else the reason in one line."""
+
+    def run(self, scene, out_dir: Path, progress: Callable[[int, int], None] | None) -> RunResult:
+        """Run a validated scene (its engine files may go under out_dir/<engine>/); call
+        progress(done, total) now and then; raise ValueError (bad input the engine
+        refused) or RuntimeError (the engine failed, non-finite values included) with
+        a one-line message."""
+
+
+def get(name) -> Adapter:
     if name not in ENGINES:
         raise ValueError(f"engine {name!r}: must be one of {', '.join(ENGINES)}")
     return importlib.import_module(f"stickslip.adapters.{name}")

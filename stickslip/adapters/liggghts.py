@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import columns
 from . import RunResult
 
 NAME = "liggghts"
@@ -246,7 +247,6 @@ def _read_dump(path):
 def _timeseries(script, work):
     sc = script.scene
     d = sc.dimension
-    axes = "xyz"[:d]
     atoms = _read_dump(work / "atoms.dump")
     pairs = _read_dump(work / "pairs.dump") if (work / "pairs.dump").is_file() else {}
     walls = _read_dump(work / "walls.dump") if (work / "walls.dump").is_file() else {}
@@ -255,16 +255,12 @@ def _timeseries(script, work):
     for name in sc.output.grains:
         i = script.ids[name] - 1
         blk = np.array([atoms[s][i] for s in steps])
-        for k, a in enumerate(axes):
-            cols[f"{name}_{a}"] = blk[:, 1 + k]
-        for k, a in enumerate(axes):
-            cols[f"{name}_v{a}"] = blk[:, 4 + k]
-        if sc.effects["rotation"]:
-            for k, a in enumerate("z" if d == 2 else "xyz"):
-                cols[f"{name}_w{a}"] = blk[:, 9 if d == 2 else 7 + k]
+        # dump columns: id x y z vx vy vz omegax omegay omegaz
+        spin = ([9] if d == 2 else [7, 8, 9]) if sc.effects["rotation"] else []
+        picks = [1 + k for k in range(d)] + [4 + k for k in range(d)] + spin
+        cols.update(zip(columns.grain(name, d, sc.effects["rotation"]), blk[:, picks].T))
     prim_order = list(script.primitive)
     for a, b in sc.output.contacts:
-        c = f"{a}-{b}"
         ia = script.ids[a]
         rec = np.zeros((len(steps), 5))  # fn, fs (3), cumulative slips
         for r, s in enumerate(steps):
@@ -285,22 +281,19 @@ def _timeseries(script, work):
                     for row in blk[blk[:, 2].astype(int) == ia]:
                         rec[r, :4] += row[3:7]
                         rec[r, 4] += row[7]
-        cols[f"{c}_fn"] = rec[:, 0]
-        cols[f"{c}_fs"] = np.linalg.norm(rec[:, 1:4], axis=1)
-        for k, x in enumerate(axes):
-            cols[f"{c}_ft{x}"] = rec[:, 1 + k]
         # slips since the previous row; a counter that drops means the contact was remade
         count = rec[:, 4]
         slips = np.diff(count, prepend=0.0)
         slips = np.where(slips < 0, count, slips)
-        cols[f"{c}_slip"] = np.rint(slips).astype(int)
-    if sc.output.stats:
-        cols["n_contacts"], cols["ekin"] = _stats(sc, atoms, pairs, walls, steps, len(prim_order))
+        values = [rec[:, 0], np.linalg.norm(rec[:, 1:4], axis=1), *rec[:, 1:1 + d].T, np.rint(slips).astype(int)]
+        cols.update(zip(columns.contact(a, b, d), values))
     for name in sc.output.walls:
         w = next(w for w in sc.walls if w.name == name)
         nrot = sc.rotation_steps(w) if w.rotation else 0
         rate = sc.rotation_rate(w) if w.rotation else 0.0
-        cols[f"{name}_angle"] = [rate * sc.dt * min(s, nrot) for s in steps]
+        cols[columns.wall(name)[0]] = [rate * sc.dt * min(s, nrot) for s in steps]
+    if sc.output.stats:
+        cols.update(zip(columns.STATS, _stats(sc, atoms, pairs, walls, steps, len(prim_order))))
     return pd.DataFrame(cols)
 
 
@@ -326,6 +319,8 @@ def _stats(sc, atoms, pairs, walls, steps, n_primitive):
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     if scene.contact.law != "stick_slip":
         raise ValueError(f"the LIGGGHTS plugin implements stick_slip only, not {scene.contact.law}")
+    if scene.output.energy:
+        raise ValueError("output.energy: the LIGGGHTS adapter does not record the energy columns")
     work = Path(out_dir).resolve() / "liggghts"
     work.mkdir(parents=True, exist_ok=True)
     for old in work.glob("*.dump"):

@@ -1,10 +1,9 @@
 """Adapter for pyref, the reference solver: runs in this process."""
 from __future__ import annotations
 
-import pandas as pd
-
 from pyref import Simulation
 
+from .. import columns
 from . import RunResult
 
 NAME = "pyref"
@@ -14,7 +13,6 @@ def available():
     return None
 
 
-def run(scene, out_dir, progress=None, energy=False):
-    sim = Simulation(scene, energy=energy)
-    columns, rows, steps, wall = sim.run(progress=progress)
-    return RunResult(pd.DataFrame(rows, columns=columns), steps, wall)
+def run(scene, out_dir, progress=None):
+    rec = Simulation(scene).run(progress=progress)
+    return RunResult(columns.frame(scene, rec), rec.steps, rec.wall_time_s)

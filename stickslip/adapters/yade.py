@@ -59,6 +59,8 @@ def scene_dict(scene):
 def run(scene, out_dir, progress=None):
     if scene.contact.law != "stick_slip":
         raise ValueError(f"the YADE law implements stick_slip only, not {scene.contact.law}")
+    if scene.output.energy:
+        raise ValueError("output.energy: the YADE adapter does not record the energy columns")
     work = Path(out_dir).resolve() / "yade"  # absolute: yade runs with work as its cwd
     work.mkdir(parents=True, exist_ok=True)
     (work / "scene.json").write_text(json.dumps(scene_dict(scene), indent=1))

@@ -1,0 +1,59 @@
+"""Case kinds: what a scene's `[analysis] kind` means, one module per kind.
+
+A kind module provides (the contract; report, precision and analysis only loop):
+- NAME, and NAMES: the `[analysis]` keys it needs, each with its rule ("grain": a
+  recorded grain, "contact": a recorded contact, "wall": a wall, "turning wall": a
+  turning wall whose angle is recorded), checked when the scene is loaded;
+- summarise(scene, df) -> dict: the headline figures of a run (summary.json);
+- errors(scene, summary, df, ref_summary, ref_df) -> dict: relative error measures of a
+  run against a converged reference run (`stickslip precision`);
+- PRECISION_DURATION: simulated time of the precision runs (None: the scene's);
+- COMPARISON_LAWS: the other tangential laws the report runs the scene with;
+- claims(scene) -> [(summary key, text)]: the report table rows;
+- figures(out, runs) -> [png names]: the report figures, from
+  runs[(law, engine)] = (scene, summary, df) of this kind's scene;
+- precision_figures(out, runs) -> [png names]: extra figures of a time-step ladder,
+  from runs[(engine, slip timing, dt)] = (scene, summary, df).
+"""
+from __future__ import annotations
+
+from ..errors import SceneError
+from . import drag, none, tilt, tray
+
+KINDS = {k.NAME: k for k in (none, drag, tray, tilt)}
+
+
+def get(name):
+    try:
+        return KINDS[name]
+    except KeyError:
+        raise SceneError(f"analysis.kind = {name!r}: must be one of {', '.join(KINDS)}") from None
+
+
+def read_names(table, kind, grains, walls, output) -> dict:
+    """The kind's `[analysis]` names, each checked against the scene (table: the reader's
+    `[analysis]` table, which then refuses any key the kind does not know)."""
+    grain_names = {g.name for g in grains}
+    turning = {w.name for w in walls if w.rotation is not None}
+    got = {}
+    for key, rule in kind.NAMES.items():
+        v = table.get(key, required=True)
+        where = table.key(key)
+        if rule == "grain":
+            if not isinstance(v, str) or v not in grain_names:
+                raise SceneError(f"{where} = {v!r}: must be a grain name")
+            if v not in output.grains:
+                raise SceneError(f"{where} = {v!r}: the grain must be recorded (add it to output.grains)")
+        elif rule == "contact":
+            if not isinstance(v, list) or v not in output.contacts:
+                raise SceneError(f"{where} = {v!r}: must be a recorded contact (one of output.contacts)")
+        elif rule == "wall":
+            if not isinstance(v, str) or v not in {w.name for w in walls}:
+                raise SceneError(f"{where} = {v!r}: must be a wall name")
+        elif rule == "turning wall":
+            if not isinstance(v, str) or v not in turning:
+                raise SceneError(f"{where} = {v!r}: must be a turning wall (with a rotation)")
+            if v not in output.walls:
+                raise SceneError(f"{where} = {v!r}: its angle must be recorded (add it to output.walls)")
+        got[key] = v
+    return got

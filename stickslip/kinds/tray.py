@@ -1,0 +1,118 @@
+"""Kind "tray" (paper §3.2, Figs. 10-12): does a grain wedged in a tray stay up?"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import plotstyle
+
+NAME = "tray"
+NAMES = {"grain": "grain", "floor": "wall"}
+# Precision runs stop once stick-slip has brought grain 1 to rest (0.15 s).
+PRECISION_DURATION = 0.4
+COMPARISON_LAWS = ("coulomb", "visco_plastic")  # the laws the paper's Fig. 11 compares
+# At rest: speed below 1 um/s from then on (1e-5 of the 0.03 m/s impact speed).
+REST_SPEED = 1e-6
+
+
+def _floor(scene):
+    return next(w for w in scene.walls if w.name == scene.analysis["floor"])
+
+
+def _grain(scene):
+    return next(g for g in scene.grains if g.name == scene.analysis["grain"])
+
+
+def height(scene, df):
+    """Grain 1's centre above the floor, per row."""
+    g, floor = scene.analysis["grain"], _floor(scene)
+    axes = "xyz"[: scene.dimension]
+    pos = df[[f"{g}_{a}" for a in axes]].to_numpy()
+    return (pos - floor.point[: scene.dimension]) @ floor.normal[: scene.dimension]
+
+
+def room(scene):
+    """Grain 1's fall room: how far its lowest point starts above the floor."""
+    g, floor = _grain(scene), _floor(scene)
+    return float((g.position - floor.point) @ floor.normal) - g.radius
+
+
+def summarise(scene, df):
+    name = scene.analysis["grain"]
+    y = height(scene, df)
+    axes = "xyz"[: scene.dimension]
+    v = np.sqrt(sum(df[f"{name}_v{a}"].to_numpy() ** 2 for a in axes))
+    t = df["t"].to_numpy()
+    moving = np.nonzero(v > REST_SPEED)[0]
+    rest = float(t[moving[-1] + 1]) if len(moving) and moving[-1] + 1 < len(t) else (
+        0.0 if not len(moving) else None)
+    r = _grain(scene).radius
+    # Touching the floor: centre closer to it than one radius.
+    bottom = np.nonzero(y < r)[0]
+    return {
+        "y1_final_m": float(y[-1]),
+        "y1_min_m": float(y.min()),
+        "radius_m": r,
+        "reached_bottom": bool(y[-1] < r),
+        "t_bottom_s": float(t[bottom[0]]) if len(bottom) else None,
+        "time_to_rest_s": rest,
+    }
+
+
+def errors(scene, summary, df, ref_summary, ref_df):
+    rest, ref_rest = summary["time_to_rest_s"], ref_summary["time_to_rest_s"]
+    return {"final_height": abs(summary["y1_final_m"] - ref_summary["y1_final_m"]) / room(scene),
+            "time_to_rest": abs(rest - ref_rest) / ref_rest if rest is not None and ref_rest else float("nan")}
+
+
+def claims(scene):
+    if scene.contact.law == "stick_slip":
+        return [("y1_final_m", f"grain 1 final height (stays above r = {_grain(scene).radius * 1e3:g} mm)"),
+                ("reached_bottom", "reaches the bottom (paper: no)"), ("time_to_rest_s", "time to rest (s)"),
+                ("wall_time_s", "wall time (s)")]
+    return [("y1_final_m", "grain 1 final height"), ("reached_bottom", "reaches the bottom (paper: yes)"),
+            ("t_bottom_s", "reaches the bottom at t (s)"), ("wall_time_s", "wall time (s)")]
+
+
+def _pair(scene):
+    """Grain 1's recorded contact with the other grain."""
+    g = scene.analysis["grain"]
+    names = {q.name for q in scene.grains}
+    return next(p for p in scene.output.contacts if g in p and set(p) <= names)
+
+
+def figures(out, runs):
+    plt = plotstyle.pyplot()
+    laws = ["stick_slip"] + [law for law in COMPARISON_LAWS if any(k[0] == law for k in runs)]
+    # Fig. 11: height of grain 1 for the three laws.
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for (law, eng), (sc, s, df) in runs.items():
+        ax.plot(df["t"], height(sc, df) * 1e3, plotstyle.ENGINE_LINES[eng], label=f"{law} [{eng}]")
+        r = _grain(sc).radius
+    ax.axhline(r * 1e3, color="k", lw=0.5)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("grain 1 centre above the floor (mm)")
+    ax.set_title("Fig. 11 — tray: grain 1 stays up only with stick-slip")
+    ax.legend(fontsize=8)
+    names = [plotstyle.save(fig, out, "fig11_tray_height.png")]
+    # Fig. 12: grain-grain tangential force along the floor's normal (vertical), per law.
+    fig, axs = plt.subplots(len(laws), 1, figsize=(7, 2.4 * len(laws)), sharex=True, squeeze=False)
+    for ax, law in zip(axs[:, 0], laws[1:] + laws[:1]):
+        for (lw, eng), (sc, s, df) in runs.items():
+            if lw != law:
+                continue
+            a, b = _pair(sc)
+            n = _floor(sc).normal
+            sign = 1.0 if a == sc.analysis["grain"] else -1.0  # the force on grain 1
+            f = sign * sum(df[f"{a}-{b}_ft{x}"].to_numpy() * n[k] for k, x in enumerate("xyz"[: sc.dimension]))
+            ax.plot(df["t"], f, plotstyle.ENGINE_LINES[eng], lw=0.8, label=eng)
+        ax.set_ylabel("Fs, vertical (N/m)")
+        ax.set_title(law, fontsize=9)
+        ax.legend(fontsize=8)
+    axs[-1, 0].set_xlabel("t (s)")
+    fig.suptitle("Fig. 12 — tray: vertical friction force on grain 1 from grain 2")
+    names.append(plotstyle.save(fig, out, "fig12_tray_friction.png"))
+    return names
+
+
+def precision_figures(out, runs):
+    return []

@@ -1,0 +1,22 @@
+"""What every report figure shares: one line style per engine, and saving a figure."""
+from __future__ import annotations
+
+ENGINE_LINES = {"pyref": "-", "liggghts": "--", "yade": ":"}
+
+
+def pyplot():
+    """matplotlib's pyplot on the file-only backend (no screen here or in CI)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save(fig, out, name, dpi=120):
+    """Write `fig` as out/name (PNG) and close it; returns the name."""
+    fig.tight_layout()
+    fig.savefig(out / name, dpi=dpi)
+    pyplot().close(fig)
+    return name

@@ -1,0 +1,86 @@
+"""Run a scene on an engine and write its results: the one place a run flows through.
+
+scene (checked) -> adapter.run -> time series (stickslip/columns.py), checked finite
+-> timeseries.csv + summary.json (headline figures from stickslip/analysis.py).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from . import adapters, analysis, columns
+from .errors import EngineError, SceneError
+from .progress import bar
+
+# Runs bigger than this (steps x grains) are announced before they start.
+ANNOUNCE_GRAIN_STEPS = 1e8
+
+
+def prepare_output(out_dir) -> Path:
+    """The output folder, made if needed; one clear line if it cannot be."""
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise SceneError(f"--out {out}: is a file, not a folder")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise SceneError(f"--out {out}: cannot be made ({e.strerror})") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise SceneError(f"--out {out}: not writable")
+    return out
+
+
+def run_scene(scene, engine, out_dir, progress=True):
+    """Run a validated scene on an engine; write timeseries.csv and summary.json into
+    out_dir; returns (summary, timeseries)."""
+    adapter = adapters.get(engine)
+    reason = adapter.available()
+    if reason is not None:
+        raise EngineError(f"engine {engine} is not available: {reason}")
+    out_dir = prepare_output(out_dir)
+    size = scene.steps * len(scene.grains)
+    if size > ANNOUNCE_GRAIN_STEPS:
+        sys.stderr.write(f"stickslip: {scene.name} on {engine}: {scene.steps:,} steps x {len(scene.grains):,} "
+                         f"grains = {size:.2g} grain-steps\n")
+    label = f"{scene.name} [{engine}, {scene.contact.law}, {scene.contact.slip_timing}]"
+    with bar(label, scene.steps, enabled=progress) as update:
+        try:
+            result = adapter.run(scene, out_dir, update)
+        except (RuntimeError, ValueError, OSError, FloatingPointError) as e:  # the engine's words, one line
+            raise EngineError(f"{engine}: {_one_line(e)}") from None
+    df = result.timeseries
+    if list(df.columns) != columns.names(scene):
+        raise EngineError(f"{engine}: the adapter wrote columns {list(df.columns)}, not {columns.names(scene)}")
+    bad = [c for c in df.columns if not np.isfinite(df[c].to_numpy(float)).all()]
+    if bad:
+        row = int(np.flatnonzero(~np.isfinite(df[bad[0]].to_numpy(float)))[0])
+        raise EngineError(f"{engine}: non-finite {bad[0]} at t = {df['t'].iloc[row]:g} s (the run diverged)")
+    df.to_csv(out_dir / "timeseries.csv", index=False)
+    summary = {
+        "scene": scene.name, "engine": engine, "law": scene.contact.law, "reset": scene.contact.reset,
+        "slip_timing": scene.contact.slip_timing, "dt_s": scene.dt, "steps": int(result.steps),
+        "wall_time_s": float(result.wall_time_s), "dimension": scene.dimension, "effects": scene.effects,
+    }
+    summary.update(analysis.summarise(scene, df))
+    notes = list(result.notes) + analysis.warnings(scene, summary)
+    summary["notes"] = notes
+    (out_dir / "summary.json").write_text(json.dumps(summary, indent=2, default=_plain) + "\n")
+    for note in notes:
+        sys.stderr.write(f"stickslip: warning: {note}\n")
+    return summary, df
+
+
+def _plain(v):
+    """JSON for numpy scalars (and NaN as null)."""
+    v = v.item() if hasattr(v, "item") else v
+    return None if isinstance(v, float) and math.isnan(v) else v
+
+
+def _one_line(e):
+    text = " ".join(str(e).split())
+    return text or type(e).__name__

@@ -1,0 +1,113 @@
+"""The data a scene file describes: contact parameters, grains, walls, output, time."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from pyref.laws import LawParams
+
+from . import stability
+
+
+@dataclass
+class Contact:
+    law: str
+    kn: float
+    nu_n: float
+    ks: float
+    nu_s: float
+    mu_s: float
+    mu_k: float
+    reset: str = "spring"
+    slip_timing: str = "step"  # step (the paper, literally) | exact (docs/law.md)
+
+    def law_params(self, effects) -> LawParams:
+        """The kernel's parameters with the scene's effects applied (damping off = 0)."""
+        return LawParams(self.law, self.kn, self.nu_n if effects["normal_damping"] else 0.0, self.ks,
+                         self.nu_s if effects["tangential_damping"] else 0.0, self.mu_s, self.mu_k,
+                         self.reset, self.slip_timing)
+
+
+@dataclass
+class Grain:
+    name: str
+    radius: float
+    density: float
+    position: np.ndarray  # always 3 components; z = 0 in 2D
+    velocity: np.ndarray
+    imposed: tuple = ()  # velocity components held at their initial value: "x", "y", "z"
+    # initial spin, rad/s, always 3 components (2D: about z only); needs effects.rotation
+    angular_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+
+@dataclass
+class WallRotation:
+    pivot: np.ndarray
+    axis: np.ndarray  # unit vector; +z in 2D
+    rate: float  # rad/s
+    stop_angle: float  # rad; the wall is held there afterwards
+
+
+@dataclass
+class Wall:
+    name: str
+    point: np.ndarray
+    normal: np.ndarray  # unit, pointing to the side where grains are
+    velocity: np.ndarray
+    rotation: WallRotation | None = None
+
+
+@dataclass
+class Output:
+    every: int = 1
+    grains: list = field(default_factory=list)
+    contacts: list = field(default_factory=list)  # [grain, grain-or-wall] pairs
+    walls: list = field(default_factory=list)
+    stats: bool = False
+    energy: bool = False  # energy columns (docs/adapters.md); engines that cannot give them refuse
+
+
+@dataclass
+class Scene:
+    name: str
+    description: str
+    dimension: int
+    effects: dict
+    gravity: np.ndarray
+    contact: Contact
+    dt: float
+    duration: float
+    grains: list
+    walls: list
+    output: Output
+    analysis: dict
+    source: Path | None = None
+
+    @property
+    def steps(self) -> int:
+        return int(round(self.duration / self.dt))
+
+    def grain_mass(self, g: Grain) -> float:
+        """Disk mass per unit thickness in 2D (the paper's convention), sphere mass in 3D."""
+        if self.dimension == 2:
+            return g.density * math.pi * g.radius**2
+        return g.density * 4.0 / 3.0 * math.pi * g.radius**3
+
+    def grain_inertia(self, g: Grain) -> float:
+        m = self.grain_mass(g)
+        return 0.5 * m * g.radius**2 if self.dimension == 2 else 0.4 * m * g.radius**2
+
+    def critical_dt(self) -> float:
+        return stability.critical_dt(self)
+
+    def rotation_steps(self, w: Wall) -> int:
+        """Steps during which a rotating wall turns: it stops exactly at stop_angle."""
+        r = w.rotation
+        return max(1, int(round(r.stop_angle / (r.rate * self.dt))))
+
+    def rotation_rate(self, w: Wall) -> float:
+        """Rate actually applied so that the wall reaches stop_angle at the end of a step."""
+        return w.rotation.stop_angle / (self.rotation_steps(w) * self.dt)

@@ -1,0 +1,418 @@
+"""Reading and checking a scene file (docs/scene-format.md).
+
+Every problem raises SceneError with one line that names the key and the allowed
+range; overrides (command line, tests) are written into the file's data before it is
+read, so they are checked by the same rules and named the same way.
+"""
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from pyref.laws import LAWS, RESETS, SLIP_TIMINGS, LawParams
+
+from .. import kinds
+from ..errors import SceneError
+from .model import Contact, Grain, Output, Scene, Wall, WallRotation
+from .stability import stability_limits
+
+CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
+EFFECTS = ("gravity", "rotation", "normal_damping", "tangential_damping", "moving_walls")
+# A scene name becomes a folder name (runs/NAME/...): letters, digits, _ . - only.
+NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}")
+# Grains may start overlapping a wall or each other by at most this share of the smaller
+# radius: the linear law models small overlaps (a resting grain: ~1e-5 r), and a deep
+# start is resolved differently by each engine (a centre behind a wall: pyref pushes the
+# grain out, YADE pulls it through, LIGGGHTS ignores the wall), so it is refused.
+MAX_START_OVERLAP = 0.1
+# More steps than this is refused: at a microsecond per step it would run for 3 hours
+# per grain, and it is almost always a mistyped dt or duration.
+MAX_STEPS = 10**10
+
+# Overrides by name -> (table, key) in the scene file.
+_OVERRIDES = {"dt": ("time", "dt"), "duration": ("time", "duration"), "every": ("output", "every"),
+              **{k: ("contact", k) for k in ("law", "kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k", "reset",
+                                             "slip_timing")},
+              **{f"effect_{e}": ("effects", e) for e in EFFECTS}}
+
+
+def find(name_or_path) -> Path:
+    """A scene given as a path, or as a name in cases/ (with or without .toml)."""
+    p = Path(name_or_path)
+    if p.is_file():
+        return p
+    for cand in (CASES_DIR / f"{name_or_path}.toml", CASES_DIR / str(name_or_path)):
+        if cand.is_file():
+            return cand
+    known = ", ".join(sorted(q.stem for q in CASES_DIR.glob("*.toml")))
+    raise SceneError(f"scene {name_or_path!r}: no such file and no such case (cases: {known})")
+
+
+def load(name_or_path, **overrides) -> Scene:
+    """Read and validate a scene. `overrides` replace values of the file before it is
+    checked: dt, duration, every, law, reset, slip_timing, kn, ..., and effects as
+    `effect_<name>=bool`."""
+    path = find(name_or_path)
+    try:
+        data = tomllib.loads(path.read_bytes().decode("utf-8"))
+    except UnicodeDecodeError:
+        raise SceneError(f"{path}: not a scene file (not UTF-8 text; scenes are TOML)") from None
+    except tomllib.TOMLDecodeError as e:
+        raise SceneError(f"{path.name}: not valid TOML ({e})") from None
+    except OSError as e:
+        raise SceneError(f"{path}: cannot be read ({e.strerror})") from None
+    return parse(data, source=path, overrides=overrides)
+
+
+def parse(data: dict, source=None, overrides=None) -> Scene:
+    data = _apply_overrides(data, overrides or {})
+    top = _Table(data, "")
+    name = top.string("name", required=True)
+    if not NAME_PATTERN.fullmatch(name):
+        raise SceneError(f"name = {name!r}: must be letters, digits, '_', '.', '-' (it names the output "
+                         "folder), at most 100 characters, starting with a letter or digit")
+    description = top.string("description", default="")
+    dim = top.get("dimension", required=True)
+    if dim not in (2, 3) or not isinstance(dim, int) or isinstance(dim, bool):
+        raise SceneError(f"dimension = {dim!r}: must be the integer 2 (disks per unit thickness) or 3 (spheres)")
+
+    et = _Table(top.get("effects", {}), "effects")
+    effects = {e: et.boolean(e, False) for e in EFFECTS}
+    et.done()
+    gravity = top.vector("gravity", dim, required=effects["gravity"])
+    if gravity is None:
+        gravity = np.zeros(3)
+
+    contact = _contact(_Table(top.get("contact", required=True), "contact"))
+
+    tt = _Table(top.get("time", required=True), "time")
+    dt = tt.number("dt", required=True, lo=0, lo_open=True)
+    duration = tt.number("duration", required=True, lo=0, lo_open=True)
+    tt.done()
+
+    grains = []
+    for i, g in enumerate(top.array("grain")):
+        gt = _Table(g, f"grain[{i}]")
+        grains.append(Grain(
+            name=gt.string("name", f"g{i}"),
+            radius=gt.number("radius", required=True, lo=0, lo_open=True),
+            density=gt.number("density", required=True, lo=0, lo_open=True),
+            position=gt.vector("position", dim, required=True),
+            velocity=gt.vector("velocity", dim, default=[0.0] * dim),
+            imposed=_axes(gt, "imposed", dim),
+            angular_velocity=_spin(gt, dim, effects["rotation"]),
+        ))
+        gt.done()
+    for i, b in enumerate(top.array("lattice")):
+        grains.extend(_lattice(_Table(b, f"lattice[{i}]"), dim, len(grains)))
+    if not grains:
+        raise SceneError("grain: a scene needs at least one [[grain]] or [[lattice]]")
+    _unique([g.name for g in grains], "grain.name")
+
+    walls = []
+    for i, w in enumerate(top.array("wall")):
+        wt = _Table(w, f"wall[{i}]")
+        normal = wt.vector("normal", dim, required=True)
+        if np.linalg.norm(normal) == 0:
+            raise SceneError(f"wall[{i}].normal: must not be the zero vector")
+        wall = Wall(
+            name=wt.string("name", f"w{i}"),
+            point=wt.vector("point", dim, required=True),
+            normal=normal / np.linalg.norm(normal),
+            velocity=wt.vector("velocity", dim, default=[0.0] * dim),
+            rotation=_rotation(wt, dim, i),
+        )
+        wt.done()
+        moving = np.any(wall.velocity != 0) or wall.rotation is not None
+        if moving and not effects["moving_walls"]:
+            raise SceneError(f"wall[{i}] ({wall.name}) moves: set effects.moving_walls = true")
+        walls.append(wall)
+    _unique([g.name for g in grains] + [w.name for w in walls], "grain/wall name")
+    _check_start(grains, walls, dim)
+
+    output = _output(_Table(top.get("output", {}), "output"), grains, walls)
+    at = _Table(top.get("analysis", {"kind": "none"}), "analysis")
+    kind = kinds.get(at.string("kind", "none", tuple(kinds.KINDS)))
+    analysis = {"kind": kind.NAME, **kinds.read_names(at, kind, grains, walls, output)}
+    at.done()
+    top.done()
+
+    scene = Scene(name, description, dim, effects, gravity, contact, dt, duration,
+                  grains, walls, output, analysis, source)
+    limits = stability_limits(scene)
+    cause = min(limits, key=limits.get)
+    if dt > limits[cause]:
+        raise SceneError(f"time.dt = {dt:.3g} s: above the stability limit; must be <= {limits[cause]:.3g} s "
+                         f"({cause} limit, from the masses, kn, ks and damping; see docs/scene-format.md)")
+    steps = duration / dt
+    if steps < 0.5:
+        raise SceneError(f"time.duration = {duration:g} s: shorter than one step (dt = {dt:g} s)")
+    if steps > MAX_STEPS:
+        raise SceneError(f"time.duration / time.dt = {steps:.3g} steps: must be <= {MAX_STEPS:.0e} "
+                         f"(duration {duration:g} s at dt {dt:g} s; is one of them mistyped?)")
+    return scene
+
+
+def _apply_overrides(data, overrides):
+    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in data.items()}
+    for k, v in overrides.items():
+        if v is None:
+            continue  # not given
+        if k not in _OVERRIDES:
+            raise SceneError(f"unknown override {k!r}: must be one of {', '.join(_OVERRIDES)}")
+        table, key = _OVERRIDES[k]
+        if not isinstance(data.get(table, {}), dict):
+            continue  # the reader will say that the table is malformed
+        data.setdefault(table, {})[key] = v
+    return data
+
+
+def _contact(ct) -> Contact:
+    law = ct.string("law", "stick_slip", LAWS)
+    spring = law in ("stick_slip", "visco_elastic")
+    contact = Contact(
+        law=law,
+        kn=ct.number("kn", required=True),
+        nu_n=ct.number("nu_n", 0.0),
+        ks=ct.number("ks", 0.0, required=spring),
+        nu_s=ct.number("nu_s", 0.0),
+        mu_s=ct.number("mu_s", required=True),
+        mu_k=ct.number("mu_k", required=True),
+        reset=ct.string("reset", "spring", RESETS),
+        slip_timing=ct.string("slip_timing", "step", SLIP_TIMINGS),
+    )
+    ct.done()
+    check_contact(contact)
+    return contact
+
+
+def check_contact(c: Contact) -> None:
+    """The law's parameter rules (docs/law.md), checked by the kernel's own checker."""
+    try:
+        LawParams(c.law, c.kn, c.nu_n, c.ks, c.nu_s, c.mu_s, c.mu_k, c.reset, c.slip_timing)
+    except ValueError as e:
+        raise SceneError(f"contact.{e}") from None
+
+
+def _output(ot, grains, walls) -> Output:
+    gnames = {g.name for g in grains}
+    wnames = {w.name for w in walls}
+    output = Output(
+        every=ot.integer("every", 1, lo=1),
+        grains=ot.names("grains", gnames, "a grain name"),
+        contacts=ot.array("contacts"),
+        walls=ot.names("walls", wnames, "a wall name"),
+        stats=ot.boolean("stats", False),
+        energy=ot.boolean("energy", False),
+    )
+    ot.done()
+    for pair in output.contacts:
+        if (not isinstance(pair, list) or len(pair) != 2 or pair[0] not in gnames
+                or pair[1] not in gnames | wnames or pair[0] == pair[1]):
+            raise SceneError(f"output.contacts: {pair!r} must be [grain, other grain or wall]")
+    return output
+
+
+def _check_start(grains, walls, dim):
+    """Refuse starting states the engines cannot agree on (MAX_START_OVERLAP)."""
+    x = np.array([g.position for g in grains])
+    r = np.array([g.radius for g in grains])
+    for w in walls:
+        dist = (x - w.point) @ w.normal
+        for i in np.flatnonzero(dist <= (1 - MAX_START_OVERLAP) * r):
+            where = "behind" if dist[i] <= 0 else "deep inside"
+            raise SceneError(f"grain {grains[i].name!r} starts {where} wall {w.name!r} (centre {dist[i]:.3g} m "
+                             f"from it, radius {r[i]:.3g} m): a grain may start overlapping a wall by at most "
+                             f"{MAX_START_OVERLAP:g} of its radius")
+    if len(grains) < 2:
+        return
+    if len(grains) <= 64:
+        a, b = np.triu_indices(len(grains), 1)
+    else:
+        from scipy.spatial import cKDTree
+
+        a, b = cKDTree(x[:, :dim]).query_pairs(2 * r.max(), output_type="ndarray").T
+    gap = np.linalg.norm(x[a] - x[b], axis=1) - (r[a] + r[b])
+    bad = np.flatnonzero(gap < -MAX_START_OVERLAP * np.minimum(r[a], r[b]))
+    if len(bad):
+        i, j = a[bad[0]], b[bad[0]]
+        raise SceneError(f"grains {grains[i].name!r} and {grains[j].name!r} start overlapping by "
+                         f"{-gap[bad[0]]:.3g} m: at most {MAX_START_OVERLAP:g} of the smaller radius")
+
+
+class _Table:
+    """A TOML table that remembers which keys were read, so unknown keys are errors."""
+
+    def __init__(self, data, where):
+        if not isinstance(data, dict):
+            raise SceneError(f"{where}: expected a table, got {_shown(data)}")
+        self.data, self.where, self.used = data, where, set()
+
+    def key(self, k):
+        return f"{self.where}.{k}" if self.where else k
+
+    def get(self, k, default=None, required=False):
+        self.used.add(k)
+        if k not in self.data:
+            if required:
+                raise SceneError(f"{self.key(k)}: missing (required)")
+            return default
+        return self.data[k]
+
+    def number(self, k, default=None, required=False, lo=None, hi=None, lo_open=False):
+        v = self.get(k, default, required)
+        if v is None:
+            return None
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise SceneError(f"{self.key(k)}: expected a finite number, got {_shown(v)}")
+        v = float(v)
+        if lo is not None and (v < lo or (lo_open and v == lo)):
+            rng = f"> {lo:g}" if lo_open else f">= {lo:g}"
+            if hi is not None:
+                rng += f" and <= {hi:g}"
+            raise SceneError(f"{self.key(k)} = {v:g}: must be {rng}")
+        if hi is not None and v > hi:
+            raise SceneError(f"{self.key(k)} = {v:g}: must be <= {hi:g}")
+        return v
+
+    def integer(self, k, default=None, lo=None, hi=None):
+        v = self.get(k, default)
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise SceneError(f"{self.key(k)}: expected a whole number, got {_shown(v)}")
+        if (lo is not None and v < lo) or (hi is not None and v > hi):
+            raise SceneError(f"{self.key(k)} = {v}: must be in [{lo if lo is not None else '-inf'}, "
+                             f"{hi if hi is not None else 'inf'}]")
+        return v
+
+    def boolean(self, k, default):
+        v = self.get(k, default)
+        if not isinstance(v, bool):
+            raise SceneError(f"{self.key(k)}: expected true or false, got {_shown(v)}")
+        return v
+
+    def string(self, k, default=None, choices=None, required=False):
+        v = self.get(k, default, required)
+        if v is None:
+            return None
+        if not isinstance(v, str):
+            raise SceneError(f"{self.key(k)}: expected a string, got {_shown(v)}")
+        if choices and v not in choices:
+            raise SceneError(f"{self.key(k)} = {v!r}: must be one of {', '.join(choices)}")
+        return v
+
+    def vector(self, k, dim, default=None, required=False):
+        v = self.get(k, default, required)
+        if v is None:
+            return None
+        if (not isinstance(v, list) or len(v) != dim
+                or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
+            raise SceneError(f"{self.key(k)}: expected {dim} finite numbers (dimension = {dim}), got {_shown(v)}")
+        out = np.zeros(3)
+        out[:dim] = v
+        return out
+
+    def array(self, k):
+        """A list (of tables or values); absent = empty."""
+        v = self.get(k, [])
+        if not isinstance(v, list):
+            raise SceneError(f"{self.key(k)}: expected a list, got {_shown(v)}")
+        return v
+
+    def names(self, k, known, what):
+        """A list of names, each one of `known`."""
+        v = self.array(k)
+        for x in v:
+            if not isinstance(x, str) or x not in known:
+                raise SceneError(f"{self.key(k)}: {_shown(x)} is not {what}")
+        return list(v)
+
+    def done(self):
+        unknown = sorted(set(self.data) - self.used)
+        if unknown:
+            raise SceneError(f"{self.key(unknown[0])}: unknown key")
+
+
+def _shown(v):
+    """A value in an error message, cut short (a whole table would not fit on one line)."""
+    text = repr(v)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _spin(gt, dim, rotation):
+    """A grain's initial angular velocity: a number (about z) in 2D, 3 numbers in 3D."""
+    if dim == 2:
+        w = np.zeros(3)
+        w[2] = gt.number("angular_velocity", 0.0)
+    else:
+        w = gt.vector("angular_velocity", 3, default=[0.0, 0.0, 0.0])
+    if np.any(w) and not rotation:
+        raise SceneError(f"{gt.key('angular_velocity')}: a spinning grain needs effects.rotation = true")
+    return w
+
+
+def _axes(t: _Table, k, dim):
+    v = t.get(k, [])
+    allowed = "xyz"[:dim]
+    if not isinstance(v, list) or any(not isinstance(a, str) or a not in allowed for a in v):
+        raise SceneError(f"{t.key(k)}: expected a list of axes from {list(allowed)}, got {_shown(v)}")
+    return tuple(v)
+
+
+def _rotation(wt: _Table, dim, i):
+    r = wt.get("rotation")
+    if r is None:
+        return None
+    rt = _Table(r, f"wall[{i}].rotation")
+    axis = rt.vector("axis", 3, default=[0.0, 0.0, 1.0]) if dim == 3 else np.array([0.0, 0.0, 1.0])
+    if np.linalg.norm(axis) == 0:
+        raise SceneError(f"wall[{i}].rotation.axis: must not be the zero vector")
+    rot = WallRotation(
+        pivot=rt.vector("pivot", dim, required=True),
+        axis=axis / np.linalg.norm(axis),
+        rate=rt.number("rate", required=True, lo=0, lo_open=True),
+        stop_angle=rt.number("stop_angle", required=True, lo=0, lo_open=True, hi=math.pi / 2),
+    )
+    rt.done()
+    return rot
+
+
+def _lattice(bt: _Table, dim, start):
+    """A block of grains on a square/cubic lattice, radii spread uniformly (seeded)."""
+    counts = bt.get("counts", required=True)
+    if (not isinstance(counts, list) or len(counts) != dim
+            or not all(isinstance(n, int) and not isinstance(n, bool) and n >= 1 for n in counts)):
+        raise SceneError(f"{bt.key('counts')}: expected {dim} positive integers, got {_shown(counts)}")
+    if math.prod(counts) > 10**7:
+        raise SceneError(f"{bt.key('counts')}: {math.prod(counts)} grains; at most 10^7 per lattice")
+    origin = bt.vector("origin", dim, required=True)
+    radius = bt.number("radius", required=True, lo=0, lo_open=True)
+    spread = bt.number("radius_spread", 0.0, lo=0, hi=0.5)
+    spacing = bt.number("spacing", 2.0 * radius * (1 + spread) * 1.05, lo=2.0 * radius * (1 + spread))
+    density = bt.number("density", required=True, lo=0, lo_open=True)
+    velocity = bt.vector("velocity", dim, default=[0.0] * dim)
+    jitter = bt.number("velocity_jitter", 0.0, lo=0)
+    seed = bt.integer("seed", 0, lo=0)
+    prefix = bt.string("prefix", "p")
+    bt.done()
+    rng = np.random.default_rng(seed)
+    grains = []
+    for idx in np.ndindex(*counts):
+        pos = origin.copy()
+        pos[:dim] += np.array(idx) * spacing
+        vel = velocity.copy()
+        vel[:dim] += jitter * rng.uniform(-1, 1, dim)
+        r = radius * (1 + spread * rng.uniform(-1, 1))
+        grains.append(Grain(f"{prefix}{start + len(grains)}", r, density, pos, vel))
+    return grains
+
+
+def _unique(names, what):
+    seen = set()
+    for n in names:
+        if n in seen:
+            raise SceneError(f"{what}: {n!r} is used twice")
+        seen.add(n)

@@ -1,0 +1,86 @@
+"""The package's shape (issue 14): no import circles, one home per idea."""
+import ast
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGES = ("stickslip", "pyref")
+
+
+def module_name(path):
+    rel = path.relative_to(ROOT).with_suffix("")
+    parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
+    return ".".join(parts)
+
+
+def imports(path, name, modules):
+    """Modules of our packages that `path` imports, at module level or inside functions
+    (a lazy import hides a circle, it does not remove it). `from P import M` of a
+    submodule M counts as importing P.M only (P is already being imported)."""
+    tree = ast.parse(path.read_text())
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    got = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            got |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                up = package.split(".")[: len(package.split(".")) - node.level + 1]
+                base = ".".join(up + ([base] if base else []))
+            subs = {f"{base}.{a.name}" for a in node.names} & modules
+            got |= subs or {base}
+    return {m for m in got if m.split(".")[0] in PACKAGES}
+
+
+def graph():
+    files = [p for pkg in PACKAGES for p in (ROOT / pkg).rglob("*.py")]
+    names = {module_name(p): p for p in files}
+    return {n: {m for m in imports(p, n, set(names)) if m in names and m != n} for n, p in names.items()}
+
+
+def find_cycle(g):
+    state, stack = {}, []
+
+    def visit(n):
+        state[n] = "open"
+        stack.append(n)
+        for m in sorted(g[n]):
+            if state.get(m) == "open":
+                return stack[stack.index(m):] + [m]
+            if m not in state and (c := visit(m)):
+                return c
+        state[n] = "done"
+        stack.pop()
+        return None
+
+    for n in sorted(g):
+        if n not in state and (c := visit(n)):
+            return c
+    return None
+
+
+def test_the_cycle_finder_finds_a_cycle():
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_no_import_circles():
+    g = graph()
+    assert len(g) > 20 and "stickslip.runner" in g["stickslip.cli"] | {"stickslip.runner"}
+    assert find_cycle(g) is None, " -> ".join(find_cycle(g))
+
+
+def test_pyref_knows_nothing_of_the_engines_or_the_package():
+    g = graph()
+    for name, deps in g.items():
+        if name.startswith("pyref"):
+            assert all(d.startswith("pyref") for d in deps), (name, deps)
+
+
+def test_case_kinds_are_only_named_in_their_modules():
+    """Report, precision, analysis and the runner loop over kinds: no kind is named there."""
+    for module in ("report", "precision", "analysis", "runner", "studies"):
+        text = (ROOT / "stickslip" / f"{module}.py").read_text()
+        code = "\n".join(line for line in text.splitlines() if not line.lstrip().startswith("#"))
+        for kind in ("kinds.drag", "kinds.tray", "kinds.tilt", '"grain_x"', '"plate_angle"', "grain1"):
+            assert kind not in code, (module, kind)
