@@ -90,6 +90,7 @@ class Simulation:
         self.W = len(s.walls)
         self.wall_n0 = np.array([w.normal for w in s.walls]).reshape(-1, 3)
         self.wall_p0 = np.array([w.point for w in s.walls]).reshape(-1, 3)
+        self.wall_v = np.array([w.velocity for w in s.walls]).reshape(-1, 3)
         self.wall_rot_steps = [s.rotation_steps(w) if w.rotation else 0 for w in s.walls]
         self.wall_rate = [s.rotation_rate(w) if w.rotation else 0.0 for w in s.walls]
         self.step_no = 0
@@ -136,12 +137,11 @@ class Simulation:
 
     def _wall_velocity(self, wk, cp, rates):
         """Velocity of walls wk at contact points cp during the last step."""
-        vw = np.array([w.velocity for w in self.walls])[wk]
-        for k in np.unique(wk):
-            if rates[k]:
-                rot = self.walls[k].rotation
-                sel = wk == k
-                vw[sel] += rates[k] * np.cross(rot.axis, cp[sel] - rot.pivot)
+        vw = self.wall_v[wk]
+        for k in np.flatnonzero(rates):
+            rot = self.walls[k].rotation
+            sel = wk == k
+            vw[sel] += rates[k] * _cross(np.broadcast_to(rot.axis, cp[sel].shape), cp[sel] - rot.pivot)
         return vw
 
     def wall_angle(self, k):

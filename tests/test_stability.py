@@ -1,4 +1,4 @@
-"""Hard cases that must stay numerically stable (pyref).
+"""Hard cases that must stay numerically stable (pyref), in both slip timings.
 
 Invariants checked at every step: all values finite, |Fs| <= mu_s*Fn (the law never
 exceeds its static threshold; 1e-12 relative for round-off), Fs = 0 when Fn = 0.
@@ -31,6 +31,7 @@ nu_s = {nu_s}
 mu_s = {mu_s}
 mu_k = {mu_k}
 reset = "{reset}"
+slip_timing = "{timing}"
 [time]
 dt = {dt}
 duration = {duration}
@@ -49,8 +50,12 @@ normal = {up}
 """
 
 
+TIMINGS = pytest.mark.parametrize("timing", ["step", "exact"])
+
+
 def make(dim=2, kn=1.2e7, ks=9.6e6, nu_n=41.38, nu_s=33.1, mu_s=0.5, mu_k=0.45, reset="spring",
-         dt=None, duration=0.01, rotation=False, height=None, vel=None, imposed=(), dt_factor=None, spin=None):
+         dt=None, duration=0.01, rotation=False, height=None, vel=None, imposed=(), dt_factor=None, spin=None,
+         timing="step"):
     r = 0.005
     m = 2600 * (math.pi * r**2 if dim == 2 else 4 / 3 * math.pi * r**3)
     y = r - m * 9.81 / kn if height is None else height
@@ -59,7 +64,7 @@ def make(dim=2, kn=1.2e7, ks=9.6e6, nu_n=41.38, nu_s=33.1, mu_s=0.5, mu_k=0.45, 
     vel = [float(v) for v in (vel or [0.0] * dim)]
     pos = [float(p) for p in pos]
     text = BASE.format(dim=dim, g=[0.0, -9.81] if dim == 2 else [0.0, 0.0, -9.81], rotation=str(rotation).lower(),
-                       kn=kn, nu_n=nu_n, ks=ks, nu_s=nu_s, mu_s=mu_s, mu_k=mu_k, reset=reset,
+                       kn=kn, nu_n=nu_n, ks=ks, nu_s=nu_s, mu_s=mu_s, mu_k=mu_k, reset=reset, timing=timing,
                        dt=dt or 1e-7, duration=duration, pos=pos, vel=vel, imposed=list(imposed),
                        zero=[0.0] * dim, up=[0.0, 1.0] if dim == 2 else [0.0, 0.0, 1.0],
                        spin="" if spin is None else f"angular_velocity = {spin}")
@@ -92,9 +97,10 @@ def test_dt_above_the_limit_is_refused_with_the_range():
         scene_mod.load("drag", dt=1.1 * scene_mod.load("drag").critical_dt())
 
 
+@TIMINGS
 @pytest.mark.parametrize("ratio", [0.01, 0.1, 1.0, 10.0])
 @pytest.mark.parametrize("zeta", [0.0, 0.3, 1.0])
-def test_runs_at_0_9_of_the_limit_stay_bounded(ratio, zeta):
+def test_runs_at_0_9_of_the_limit_stay_bounded(ratio, zeta, timing):
     """Grain dropped with 10x its static overlap while sliding, at 0.9*dt_crit, for Ks/Kn
     from 0.01 to 10 and damping from 0 to critical (zeta = nu/(2 sqrt(k m))): it bounces
     and slides, and its speed must stay below what its start speed and stored energy
@@ -105,7 +111,7 @@ def test_runs_at_0_9_of_the_limit_stay_bounded(ratio, zeta):
     m = 2600 * math.pi * 0.005**2
     overlap = 10 * m * 9.81 / kn
     sc = make(kn=kn, ks=ks, nu_n=zeta * 2 * math.sqrt(kn * m), nu_s=zeta * 2 * math.sqrt(ks * m),
-              height=0.005 - overlap, vel=[0.05, 0.0], dt_factor=0.9)
+              height=0.005 - overlap, vel=[0.05, 0.0], dt_factor=0.9, timing=timing)
     sim = run_checked(sc, steps=4000)
     v_bound = 1.2 * (0.05 + math.sqrt(kn * overlap**2 / m))
     assert np.abs(sim.v).max() < v_bound
@@ -154,12 +160,13 @@ def test_the_oscillator_limit_is_real_just_above_it_grows():
 
 
 # ---------------------------------------------------------------- friction extremes
+@TIMINGS
 @pytest.mark.parametrize("mu_k,mean", [(0.5, 0.5), (0.25, 0.25)])
-def test_plain_slider_and_zero_fmin(mu_k, mean):
+def test_plain_slider_and_zero_fmin(mu_k, mean, timing):
     """mu_k = mu_s: the slider holds mu_s*Fn while sliding; mu_k = mu_s/2: Fmin = 0 and the
     saw-tooth runs from 0 to mu_s*Fn, mean mu_s/2 (within 1 %, the dashpot's share)."""
     # At 1e-4 m/s the static phase lasts mu_s*Fn/(Ks*V) = 1 ms; 10 ms holds ~9 teeth.
-    sc = make(dim=2, vel=[1e-4, 0.0], imposed=["x"], mu_k=mu_k, dt=2e-6, duration=0.01)
+    sc = make(dim=2, vel=[1e-4, 0.0], imposed=["x"], mu_k=mu_k, dt=2e-6, duration=0.01, timing=timing)
     sim = Simulation(sc, record=False)
     ratios, slips = [], []
     for _ in range(sc.steps):
@@ -174,10 +181,11 @@ def test_plain_slider_and_zero_fmin(mu_k, mean):
     assert window.mean() == pytest.approx(mean, rel=0.01)
 
 
-def test_contact_opening_while_sliding():
+@TIMINGS
+def test_contact_opening_while_sliding(timing):
     """A grain bouncing while it is dragged: whenever Fn = 0 the tangential force is 0,
     and a contact that ends restarts with a zero spring."""
-    sc = make(vel=[0.01, 0.0], imposed=["x"], height=0.005 - 2e-5, nu_n=0.0, duration=0.02, dt=2e-6)
+    sc = make(vel=[0.01, 0.0], imposed=["x"], height=0.005 - 2e-5, nu_n=0.0, duration=0.02, dt=2e-6, timing=timing)
 
     def check(sim):
         i, j, key, n, fn, F_s, slipped, delta = sim.contacts
@@ -188,10 +196,11 @@ def test_contact_opening_while_sliding():
     assert sim.slip_steps > 0
 
 
-def test_sliding_direction_reversing():
+@TIMINGS
+def test_sliding_direction_reversing(timing):
     """The drive reverses every 2 ms: the friction must follow, stay bounded, and average
     to about zero over a full back-and-forth cycle."""
-    sc = make(vel=[1e-3, 0.0], imposed=["x"], duration=0.016, dt=2e-6)
+    sc = make(vel=[1e-3, 0.0], imposed=["x"], duration=0.016, dt=2e-6, timing=timing)
     sim = Simulation(sc, record=False)
     fx = []
     for k in range(sc.steps):
@@ -206,14 +215,15 @@ def test_sliding_direction_reversing():
     assert abs(fx[4000:].mean()) < 0.05 * np.abs(fx).max()
 
 
-def test_grain_spinning_on_a_plane():
+@TIMINGS
+def test_grain_spinning_on_a_plane(timing):
     """A disk set spinning (w0 = 50 rad/s) on the floor, rotation on. Friction brakes the
     spin and drives the centre until it rolls: angular momentum about the contact point
     is conserved, so it ends with w = w0/3 and v = -w*r, keeping 1/3 of its kinetic
     energy (then rolls on: the law has no rolling resistance). Tolerance 2 %: the
     spring's elastic share and the dashpot's loss while sticking."""
     w0 = 50.0
-    sc = make(rotation=True, duration=0.1, dt=5e-6, spin=w0)
+    sc = make(rotation=True, duration=0.1, dt=5e-6, spin=w0, timing=timing)
     sim = Simulation(sc, record=False)
     e0 = sim.kinetic_energy()
     assert e0 == pytest.approx(0.5 * sc.grain_inertia(sc.grains[0]) * w0**2, rel=1e-12)
@@ -228,18 +238,20 @@ def test_grain_spinning_on_a_plane():
     assert sim.slip_steps > 0  # it did slide before rolling
 
 
+@TIMINGS
 @pytest.mark.parametrize("angle_deg", [1.0, 5.0, 20.0])
-def test_grazing_impacts_at_high_speed(angle_deg):
+def test_grazing_impacts_at_high_speed(angle_deg, timing):
     """A sphere hitting the floor at 10 m/s and a grazing angle, rotation on."""
     a = math.radians(angle_deg)
     sc = make(dim=3, kn=1e5, ks=8e4, nu_n=0.5, nu_s=0.2, rotation=True, height=0.0052,
-              vel=[10 * math.cos(a), 0.0, -10 * math.sin(a)], duration=0.002, dt=1e-6)
+              vel=[10 * math.cos(a), 0.0, -10 * math.sin(a)], duration=0.002, dt=1e-6, timing=timing)
     sim = run_checked(sc)
     assert sim.x[0, 2] > 0  # never tunnels through the floor
 
 
 # ---------------------------------------------------------------- randomised parameters
-def test_randomised_parameter_sets():
+@TIMINGS
+def test_randomised_parameter_sets(timing):
     """60 seeded random parameter sets (stiffness ratio, damping, friction pair, reset rule,
     2D/3D, rotation, drag speed): at every step all finite and |Fs| <= mu_s*Fn."""
     rng = np.random.default_rng(20241122)
@@ -257,7 +269,7 @@ def test_randomised_parameter_sets():
         sc = make(dim=dim, kn=kn, ks=ks, nu_n=zeta_n * 2 * math.sqrt(kn * m),
                   nu_s=zeta_s * 2 * math.sqrt(ks * m), mu_s=mu_s, mu_k=mu_k,
                   reset=str(rng.choice(["spring", "total"])), rotation=bool(rng.integers(2)),
-                  vel=vel, height=r - 3 * m * 9.81 / kn, dt_factor=rng.uniform(0.1, 0.9))
+                  vel=vel, height=r - 3 * m * 9.81 / kn, dt_factor=rng.uniform(0.1, 0.9), timing=timing)
         run_checked(sc, steps=400)
 
 
