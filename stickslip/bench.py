@@ -122,10 +122,32 @@ def pyref_rows(reps):
     t, c = time_steps(sc, 60, reps)
     rows.append({"benchmark": "pyref", "case": "~10 000 contacts (target >= 2e6 contact-steps/s)",
                  "contacts": round(c), "seconds_per_step": t, "contact_steps_per_s": c / t})
+    rows += timing_rows(reps)
     g, k, peak = memory(sc)
     rows.append({"benchmark": "pyref", "case": "memory: bytes per grain (state)", "value": g})
     rows.append({"benchmark": "pyref", "case": "memory: bytes per contact (history + key)", "value": k})
     rows.append({"benchmark": "pyref", "case": "memory: peak transient bytes per contact in a step", "value": peak})
+    return rows
+
+
+def timing_rows(reps, n=3400):
+    """Cost of the exact slip timing against the step timing, per contact-step, on the
+    packing at rest (contacts stick: the exact mode only adds a threshold test) and set
+    sliding (every grain with a random velocity of 0.05 m/s: contacts slip, several times
+    a step, and the exact mode follows each slip). Same process, one after the other."""
+    rows = []
+    for state, extra in (("at rest", {}), ("sliding", {"jitter": 0.05})):
+        costs = {}
+        for timing in ("step", "exact"):
+            sc = packing(n, slip_timing=timing)
+            for g in sc.grains:  # seeded, the same for both modes
+                g.velocity = np.random.default_rng(hash(g.name) % 2**32).uniform(-1, 1, 3) * extra.get("jitter", 0.0)
+            t, c = time_steps(sc, 60, reps)
+            costs[timing] = t / c
+            rows.append({"benchmark": "pyref", "case": f"slip timing {timing}, packing {state}, s per contact-step",
+                         "contacts": round(c), "value": t / c})
+        rows.append({"benchmark": "pyref", "case": f"exact / step timing cost, packing {state}",
+                     "value": costs["exact"] / costs["step"]})
     return rows
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from pyref import Simulation
 from pyref.laws import every_step_slips_speed
 
-from . import plotstyle
+from . import parallel, plotstyle
 from . import scene as scene_mod
 
 SPEEDS = np.logspace(-6, -2, 17)  # m/s: 4 decades, past the dashpot threshold (~1e-3 m/s)
@@ -49,23 +49,33 @@ def mean_friction(base, speed, dt, timing):
     return float(ratio[slips[0] + 1: slips[-1] + 1].mean())
 
 
-def run_friction_speed(out: Path, scene="drag", speeds=SPEEDS, dt_factors=DT_FACTORS):
+def run_friction_speed(out: Path, scene="drag", speeds=SPEEDS, dt_factors=DT_FACTORS, progress=True):
+    tasks, finish = plan(out, scene, speeds, dt_factors)
+    return finish(parallel.run_all(tasks, "friction vs speed", progress))
+
+
+def plan(out: Path, scene="drag", speeds=SPEEDS, dt_factors=DT_FACTORS):
+    """Tasks for parallel.run_all (one drag run each), and the function that writes the
+    CSV and the figure from their results."""
     base = scene_mod.load(scene)
-    rows = []
-    for timing in ("step", "exact"):
-        for f in dt_factors:
-            dt = base.dt * f
-            for v in speeds:
-                rows.append({"slip_timing": timing, "dt_s": dt, "speed_mps": float(v),
-                             "mean_fs_fn": mean_friction(scene, float(v), dt, timing)})
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    with open(out / "friction_speed.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    _plot(base, rows, out / "friction_speed.png")
-    return rows
+    keys = [(timing, base.dt * f, float(v)) for timing in ("step", "exact") for f in dt_factors for v in speeds]
+    tasks = [(1.0 / (dt * v), mean_friction, (scene, v, dt, timing)) for timing, dt, v in keys]
+
+    def finish(results):
+        rows = []
+        for (timing, dt, v), got in zip(keys, results):
+            if isinstance(got, Exception):
+                raise got
+            rows.append({"slip_timing": timing, "dt_s": dt, "speed_mps": v, "mean_fs_fn": got})
+        Path(out).mkdir(parents=True, exist_ok=True)
+        with open(Path(out) / "friction_speed.csv", "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+        _plot(base, rows, Path(out) / "friction_speed.png")
+        return rows
+
+    return tasks, finish
 
 
 def spread(rows, timing):

@@ -14,9 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import kinds, plotstyle
+from . import kinds, parallel, plotstyle, runner
 from . import scene as scene_mod
-from .runner import run_scene
 
 DEFAULT_FACTORS = (8, 4, 2, 1, 0.5, 0.25)  # x the scene's dt: 6 steps over 1.5 decades
 TIMING_LINES = {"step": "--", "exact": "-"}
@@ -29,9 +28,18 @@ def ladder(sc, factors):
 
 
 def run_precision(scene_name, engines, out: Path, factors=None, progress=True, reference="pyref",
-                  timings=("step", "exact")):
-    """The ladder on each engine in each slip timing; returns the CSV path and the fitted
-    convergence orders {(engine, timing, measure): order}."""
+                  timings=("step", "exact"), engine_min_factor=None):
+    """The ladder on each engine in each slip timing, on every core; returns the CSV path
+    and the fitted convergence orders {(engine, timing, measure): order}."""
+    tasks, finish = plan(scene_name, engines, out, factors, reference, timings, engine_min_factor)
+    return finish(parallel.run_all(tasks, f"precision {scene_name}", progress))
+
+
+def plan(scene_name, engines, out: Path, factors=None, reference="pyref", timings=("step", "exact"),
+         engine_min_factor=None):
+    """The runs of a ladder as tasks for parallel.run_all, and the function that turns
+    their results into the CSV, the orders and the diagrams. `engine_min_factor`: engines
+    other than the reference skip steps finer than that factor of the scene's dt."""
     base = scene_mod.load(scene_name)
     kind = kinds.get(base.analysis["kind"])
     dts = ladder(base, factors or DEFAULT_FACTORS)
@@ -40,18 +48,27 @@ def run_precision(scene_name, engines, out: Path, factors=None, progress=True, r
                                    f"({0.9 * base.critical_dt():.3g} s)")
     out = Path(out)
     ref_key = (reference, "exact", min(dts))
-    plan = [ref_key] + [(e, m, dt) for e in dict.fromkeys([reference, *engines]) for m in timings for dt in dts
-                        if (e, m, dt) != ref_key]
-    runs = {}
-    for eng, timing, dt in plan:
-        sc = scene_mod.load(scene_name, dt=dt, slip_timing=timing, duration=kind.PRECISION_DURATION)
-        d = out / "runs" / eng / timing / f"dt_{dt:.3e}"
-        try:
-            runs[(eng, timing, dt)] = (sc, *run_scene(sc, eng, d, progress=progress))
-        except Exception as e:  # one engine failing leaves the others' diagram
-            if (eng, timing, dt) == ref_key:
-                raise
-            print(f"stickslip: precision: {eng} ({timing}) at dt={dt:g} failed: {e}")
+    keys = [ref_key] + [(e, m, dt) for e in dict.fromkeys([reference, *engines]) for m in timings for dt in dts
+                        if (e, m, dt) != ref_key
+                        and (e == reference or engine_min_factor is None or dt >= base.dt * engine_min_factor * 0.999)]
+    tasks = [runner.task(scene_name, eng, out / "runs" / eng / timing / f"dt_{dt:.3e}", dt=dt, slip_timing=timing,
+                         duration=kind.PRECISION_DURATION) for eng, timing, dt in keys]
+
+    def finish(results):
+        runs = {}
+        for key, got in zip(keys, results):
+            if isinstance(got, Exception):
+                if key == ref_key:
+                    raise got
+                print(f"stickslip: precision: {key[0]} ({key[1]}) at dt={key[2]:g} failed: {got}")
+                continue
+            runs[key] = got
+        return _finish(base, kind, runs, ref_key, out)
+
+    return tasks, finish
+
+
+def _finish(base, kind, runs, ref_key, out):
     _, ref_summary, ref_df = runs[ref_key]
     rows = []
     for (eng, timing, dt), (sc, s, df) in sorted(runs.items(), key=lambda kv: (kv[0][0], kv[0][1], -kv[0][2])):
@@ -66,7 +83,7 @@ def run_precision(scene_name, engines, out: Path, factors=None, progress=True, r
         w.writeheader()
         w.writerows(rows)
     orders = _plots(base.name, rows, out, ref_key)
-    kind.precision_figures(out, {k: v for k, v in runs.items() if k[0] == reference})
+    kind.precision_figures(out, {k: v for k, v in runs.items() if k[0] == ref_key[0]})
     return csv_path, orders
 
 

@@ -16,6 +16,7 @@ import numpy as np
 from . import adapters, analysis, columns
 from .errors import EngineError, SceneError
 from .progress import bar
+from .scene import load as scene_load
 
 # Runs bigger than this (steps x grains) are announced before they start.
 ANNOUNCE_GRAIN_STEPS = 1e8
@@ -84,3 +85,24 @@ def _plain(v):
 def _one_line(e):
     text = " ".join(str(e).split())
     return text or type(e).__name__
+
+
+# Rough seconds per grain-step, only to run the longest jobs first (stickslip/parallel.py).
+_SPEED = {"pyref": 4e-5, "liggghts": 3e-6, "yade": 1e-4}
+_START = {"pyref": 0.0, "liggghts": 0.5, "yade": 1.5}  # process start-up, s
+
+
+def cost(scene, engine) -> float:
+    return scene.steps * (len(scene.grains) + len(scene.walls)) * _SPEED[engine] + _START[engine]
+
+
+def run_named(scene_name, engine, out_dir, overrides):
+    """A task for stickslip/parallel.py: load a scene with overrides and run it quietly;
+    returns (scene, summary, timeseries)."""
+    sc = scene_load(scene_name, **overrides)
+    return (sc, *run_scene(sc, engine, out_dir, progress=False))
+
+
+def task(scene_name, engine, out_dir, **overrides):
+    """(cost, function, args) of one run, for parallel.run_all."""
+    return (cost(scene_load(scene_name, **overrides), engine), run_named, (scene_name, engine, out_dir, overrides))

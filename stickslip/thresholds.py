@@ -18,7 +18,7 @@ import numpy as np
 
 from pyref.laws import every_step_slips_speed
 
-from . import plotstyle
+from . import parallel, plotstyle
 from . import scene as scene_mod
 
 DTS = (1e-6, 4e-6, 1.6e-5)
@@ -72,22 +72,39 @@ def measure(base, dt, nu_s, rel_tol=1e-3):
     return (lo * hi) ** 0.5, guess
 
 
-def run_thresholds(out: Path, dts=DTS, nus=NU_S):
-    base = scene_mod.load("drag")
-    rows = []
-    for nu in nus:
-        for dt in dts:
-            measured, predicted = measure(base, dt, nu)
+def run_thresholds(out: Path, dts=DTS, nus=NU_S, progress=True):
+    tasks, finish = plan(out, dts, nus)
+    return finish(parallel.run_all(tasks, "thresholds", progress))
+
+
+def plan(out: Path, dts=DTS, nus=NU_S):
+    """Tasks for parallel.run_all (one bisection each) and the function that writes the
+    CSV and the figure from their results."""
+    keys = [(nu, dt) for nu in nus for dt in dts]
+    tasks = [(1.0 / dt, _measure_drag, (dt, nu)) for nu, dt in keys]
+
+    def finish(results):
+        rows = []
+        for (nu, dt), got in zip(keys, results):
+            if isinstance(got, Exception):
+                raise got
+            measured, predicted = got
             rows.append({"dt_s": dt, "nu_s": nu, "v_star_measured_mps": measured,
                          "v_star_formula_mps": predicted, "rel_diff": measured / predicted - 1})
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    with open(out / "thresholds.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    _plot(rows, out / "thresholds.png")
-    return rows
+        out_dir = Path(out)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        with open(out_dir / "thresholds.csv", "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+        _plot(rows, out_dir / "thresholds.png")
+        return rows
+
+    return tasks, finish
+
+
+def _measure_drag(dt, nu_s):
+    return measure(scene_mod.load("drag"), dt, nu_s)
 
 
 def _plot(rows, path):

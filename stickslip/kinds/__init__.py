@@ -9,9 +9,11 @@ A kind module provides (the contract; report, precision and analysis only loop):
   run against a converged reference run (`stickslip precision`);
 - PRECISION_DURATION: simulated time of the precision runs (None: the scene's);
 - COMPARISON_LAWS: the other tangential laws the report runs the scene with;
+- REPORT_TIMINGS: the slip timings the report runs the scene in;
 - claims(scene) -> [(summary key, text)]: the report table rows;
+- paper_statements(scene) -> [kinds.paper.Statement]: what the paper says, checked;
 - figures(out, runs) -> [png names]: the report figures, from
-  runs[(law, engine)] = (scene, summary, df) of this kind's scene;
+  runs[(law, slip timing, engine)] = (scene, summary, df) of this kind's scene;
 - precision_figures(out, runs) -> [png names]: extra figures of a time-step ladder,
   from runs[(engine, slip timing, dt)] = (scene, summary, df).
 """

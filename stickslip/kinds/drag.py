@@ -8,11 +8,13 @@ from __future__ import annotations
 import numpy as np
 
 from .. import plotstyle, stick_resolution
+from .paper import Statement, near
 
 NAME = "drag"
 NAMES = {"contact": "contact", "grain": "grain"}
 PRECISION_DURATION = None
 COMPARISON_LAWS = ()
+REPORT_TIMINGS = ("step",)
 
 
 def prefix(scene):
@@ -90,7 +92,7 @@ def figures(out, runs):
     plt = plotstyle.pyplot()
     fig, (a, b) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     fn = None
-    for (law, eng), (sc, s, df) in runs.items():
+    for (law, timing, eng), (sc, s, df) in runs.items():
         c, g = prefix(sc), sc.analysis["grain"]
         disp = (df[f"{g}_x"] - df[f"{g}_x"].iloc[0]) * 1e6
         a.plot(disp, df[f"{c}_fs"], plotstyle.ENGINE_LINES[eng], label=eng)
@@ -112,3 +114,24 @@ def figures(out, runs):
 
 def precision_figures(out, runs):
     return []
+
+
+def paper_statements(scene):
+    """Paper §3.1 beside ours (kinds/paper.py)."""
+    p = scene.contact
+    return [
+        Statement("§3.1", "In the static phase the friction rises linearly to the static threshold μs·Fn",
+                  lambda s: s["fs_fn_max"], near(p.mu_s, 0.005),
+                  how="largest |Fs|/Fn within 0.5 % of μs (one step's loading is 0.12 % of it at the scene's dt)"),
+        Statement("§3.1", "In the dynamic phase it switches between μs·Fn and the dynamic limit (2μk−μs)·Fn",
+                  lambda s: s["fs_fn_min"], near(2 * p.mu_k - p.mu_s, 0.005),
+                  how="least |Fs|/Fn over whole periods within 0.5 % of 2μk−μs"),
+        Statement("§3.1", "The lower limit is chosen so that the average tangential force is μk·Fn",
+                  lambda s: s["fs_fn_mean"], near(p.mu_k, 0.005),
+                  how="mean |Fs|/Fn over whole periods within 0.5 % of μk (the dashpot adds νs·V/(2Fn) = 0.05 %)"),
+        Statement("§3.1", "During the stick periods there is no sliding: the force rises with the displacement",
+                  lambda s: s["slip_period_s"] / s["slip_period_expected_s"] if s.get("slip_period_s") else None,
+                  near(1.0, 0.01),
+                  how="slip period over (2(μs−μk)Fn − νs·V)/(Ks·V), the period of a spring that follows the "
+                      "imposed displacement while sticking, within 1 % (one step is 0.6 %)"),
+    ]

@@ -3,6 +3,7 @@ NAME = "none"
 NAMES = {}
 PRECISION_DURATION = None
 COMPARISON_LAWS = ()
+REPORT_TIMINGS = ("step",)
 
 
 def summarise(scene, df):
@@ -22,4 +23,8 @@ def figures(out, runs):
 
 
 def precision_figures(out, runs):
+    return []
+
+
+def paper_statements(scene):
     return []

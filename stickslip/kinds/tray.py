@@ -4,12 +4,14 @@ from __future__ import annotations
 import numpy as np
 
 from .. import plotstyle
+from .paper import Statement, near
 
 NAME = "tray"
 NAMES = {"grain": "grain", "floor": "wall"}
 # Precision runs stop once stick-slip has brought grain 1 to rest (0.15 s).
 PRECISION_DURATION = 0.4
 COMPARISON_LAWS = ("coulomb", "visco_plastic")  # the laws the paper's Fig. 11 compares
+REPORT_TIMINGS = ("step",)
 # At rest: speed below 1 um/s from then on (1e-5 of the 0.03 m/s impact speed).
 REST_SPEED = 1e-6
 
@@ -48,7 +50,7 @@ def summarise(scene, df):
     r = _grain(scene).radius
     # Touching the floor: centre closer to it than one radius.
     bottom = np.nonzero(y < r)[0]
-    return {
+    out = {
         "y1_final_m": float(y[-1]),
         "y1_min_m": float(y.min()),
         "radius_m": r,
@@ -56,6 +58,38 @@ def summarise(scene, df):
         "t_bottom_s": float(t[bottom[0]]) if len(bottom) else None,
         "time_to_rest_s": rest,
     }
+    out.update(_pair_figures(scene, df, t, y, bottom[0] if len(bottom) else len(t)))
+    return out
+
+
+def _pair_figures(scene, df, t, y, end):
+    """The grain-grain contact's friction (N/m in 2D) and grain 1's way down, until it
+    reaches the bottom (row `end`)."""
+    a, b = _pair(scene)
+    fn, fs = df[f"{a}-{b}_fn"].to_numpy(), df[f"{a}-{b}_fs"].to_numpy()
+    n = _floor(scene).normal
+    sign = 1.0 if a == scene.analysis["grain"] else -1.0
+    up = sign * sum(df[f"{a}-{b}_ft{x}"].to_numpy() * n[k] for k, x in enumerate("xyz"[: scene.dimension]))
+    touching = np.flatnonzero(fn > 0)
+    out = {"pair_fs_final_N": float(fs[-1]), "pair_fs_peak_N": float(fs.max())}
+    if len(touching) >= 10:
+        # the vertical friction on grain 1 takes both signs (Coulomb: it flips at every step)
+        out["pair_fs_sign_share"] = float(min(np.mean(up[touching] > 0), np.mean(up[touching] < 0)))
+        tenth = max(1, len(touching) // 10)
+        out["pair_fn_growth"] = float(fn[touching[-tenth:]].mean() / fn[touching[:tenth]].mean())
+    # slow-downs on the way down: grain 1's downward speed falls by a tenth of its
+    # running maximum, then rises again (counted while it moves: above 100 REST_SPEED)
+    down = -np.gradient(y[:end], t[:end]) if end > 2 else np.zeros(0)
+    turns, peak, falling = 0, 0.0, False
+    for v in down:
+        if v > peak and v > 100 * REST_SPEED:
+            if falling:
+                turns += 1
+            peak, falling = v, False
+        elif v < 0.9 * peak:
+            falling, peak = True, v
+    out["slowdowns_before_bottom"] = turns
+    return out
 
 
 def errors(scene, summary, df, ref_summary, ref_df):
@@ -82,10 +116,10 @@ def _pair(scene):
 
 def figures(out, runs):
     plt = plotstyle.pyplot()
-    laws = ["stick_slip"] + [law for law in COMPARISON_LAWS if any(k[0] == law for k in runs)]
+    laws = ["stick_slip"] + [law for law in COMPARISON_LAWS if any(key[0] == law for key in runs)]
     # Fig. 11: height of grain 1 for the three laws.
     fig, ax = plt.subplots(figsize=(7, 4))
-    for (law, eng), (sc, s, df) in runs.items():
+    for (law, timing, eng), (sc, s, df) in runs.items():
         ax.plot(df["t"], height(sc, df) * 1e3, plotstyle.ENGINE_LINES[eng], label=f"{law} [{eng}]")
         r = _grain(sc).radius
     ax.axhline(r * 1e3, color="k", lw=0.5)
@@ -97,7 +131,7 @@ def figures(out, runs):
     # Fig. 12: grain-grain tangential force along the floor's normal (vertical), per law.
     fig, axs = plt.subplots(len(laws), 1, figsize=(7, 2.4 * len(laws)), sharex=True, squeeze=False)
     for ax, law in zip(axs[:, 0], laws[1:] + laws[:1]):
-        for (lw, eng), (sc, s, df) in runs.items():
+        for (lw, timing, eng), (sc, s, df) in runs.items():
             if lw != law:
                 continue
             a, b = _pair(sc)
@@ -116,3 +150,38 @@ def figures(out, runs):
 
 def precision_figures(out, runs):
     return []
+
+
+# "close to 0.6 N": the paper quotes one digit; we read it as within 10 %.
+PAPER_FRICTION_N = 0.6
+PAPER_VISCO_PLASTIC_BOTTOM_S = 2.65
+
+
+def paper_statements(scene):
+    """Paper §3.2 beside ours (kinds/paper.py)."""
+    return [
+        Statement("§3.2", "Stick-slip: grain 1 is held above the bottom of the tray",
+                  lambda s: s["reached_bottom"], lambda v: v is False, how="grain 1's centre stays above r"),
+        Statement("§3.2", "Stick-slip: the friction reaches a constant value close to 0.6 N",
+                  lambda s: s["pair_fs_final_N"], near(PAPER_FRICTION_N, 0.1),
+                  how="grain-grain |Fs| at the end (N/m) within 10 % of 0.6 (the paper quotes one digit)"),
+        Statement("§3.2", "Coulomb: grain 1 reaches the bottom", lambda s: s["reached_bottom"], lambda v: v is True,
+                  law="coulomb", how="grain 1's centre ends below r"),
+        Statement("§3.2", "Coulomb: the force alternates between two values of opposite sign",
+                  lambda s: s.get("pair_fs_sign_share"), lambda v: v > 0.2, law="coulomb",
+                  how="share of touching rows with the rarer sign of the vertical friction above 20 %"),
+        Statement("§3.2", "Coulomb: the threshold grows as the overlap (normal force) grows",
+                  lambda s: s.get("pair_fn_growth"), lambda v: v > 1.0, law="coulomb",
+                  how="grain-grain Fn over the last tenth of contact over the first tenth above 1"),
+        Statement("§3.2", "Visco-plastic: grain 1 reaches the bottom", lambda s: s["reached_bottom"],
+                  lambda v: v is True, law="visco_plastic", how="grain 1's centre ends below r"),
+        Statement("§3.2", "Visco-plastic: it reaches the bottom at t = 2.65 s", lambda s: s["t_bottom_s"],
+                  near(PAPER_VISCO_PLASTIC_BOTTOM_S, 0.05), law="visco_plastic",
+                  how="time grain 1's centre first comes within r of the floor, within 5 % of 2.65 s"),
+        Statement("§3.2", "Visco-plastic: the friction is initially close to 0.6 N", lambda s: s["pair_fs_peak_N"],
+                  near(PAPER_FRICTION_N, 0.1), law="visco_plastic",
+                  how="largest grain-grain |Fs| (N/m) within 10 % of 0.6"),
+        Statement("§3.2", "Visco-plastic: grain 1 slows down and accelerates again (continuous movement)",
+                  lambda s: s["slowdowns_before_bottom"], lambda v: v >= 2, law="visco_plastic",
+                  how="at least two slow-downs (speed falling by a tenth, then rising) before the bottom"),
+    ]
