@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import csv
 import importlib
+import os
 import statistics
 import time
 import tracemalloc
@@ -168,7 +169,23 @@ def effect_rows(reps):
     return rows
 
 
-def run_bench(out: Path, reps=3, engines=None):
+def report_rows():
+    """`stickslip report` as the README runs it (every engine, every study), timed once,
+    into a temporary folder: the wall time a user waits, and how many processes ran."""
+    import tempfile
+
+    from . import parallel
+    from .report import build_report
+
+    with tempfile.TemporaryDirectory(prefix="stickslip-report-") as tmp:
+        t0 = time.perf_counter()
+        build_report(Path(tmp), progress=True)
+        wall = time.perf_counter() - t0
+    return [{"benchmark": "report", "case": f"stickslip report, wall time s ({parallel.workers()} processes, "
+                                            f"{os.cpu_count()} cores; target <= 480)", "value": wall}]
+
+
+def run_bench(out: Path, reps=3, engines=None, report=False):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     rows = pyref_rows(reps) + effect_rows(reps)
@@ -179,6 +196,8 @@ def run_bench(out: Path, reps=3, engines=None):
         except ModuleNotFoundError:
             continue
         rows += engine_bench.benchmark(reps)
+    if report:
+        rows += report_rows()
     fields = ["benchmark", "case", "contacts", "seconds_per_step", "contact_steps_per_s", "ratio_to_all_on", "value"]
     with open(out / "bench.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")

@@ -80,6 +80,7 @@ def build_parser():
     be = sub.add_parser("bench", help="performance figures (pyref, and engines that provide a benchmark)")
     be.add_argument("--out", type=Path, default=Path("bench"), help="output folder (default: bench)")
     be.add_argument("--reps", type=_count, default=3, help="repetitions per figure (median quoted)")
+    be.add_argument("--report", action="store_true", help="also time `stickslip report` (all engines and studies)")
 
     rep = sub.add_parser("report", help="run the paper's cases on every available engine; figures + report.md")
     rep.add_argument("--out", type=Path, default=Path("report"), help="output folder (default: report)")
@@ -149,7 +150,7 @@ def cmd_bench(args):
     from .bench import run_bench
     from .runner import prepare_output
 
-    run_bench(prepare_output(args.out), reps=args.reps)
+    run_bench(prepare_output(args.out), reps=args.reps, report=args.report)
     return 0
 
 
