@@ -100,6 +100,14 @@ def main(argv=None):
     except EngineError as e:
         sys.stderr.write(f"stickslip: error: {e}\n")
         return 1
+    except OSError as e:  # the file system refused (a full disk, a folder gone during the run)
+        where = f"{e.filename}: " if e.filename else ""
+        sys.stderr.write(f"stickslip: error: {where}{e.strerror or e}\n")
+        return 1
+    except MemoryError:
+        sys.stderr.write("stickslip: error: out of memory (the scene or its output is too big for this "
+                         "machine: fewer grains, a shorter run or a larger output.every)\n")
+        return 1
     except KeyboardInterrupt:
         sys.stderr.write("stickslip: interrupted\n")
         return 130
@@ -119,10 +127,23 @@ def cmd_run(args):
 
 
 def cmd_precision(args):
-    from .precision import run_precision
+    from . import kinds
+    from .precision import DEFAULT_FACTORS, ladder, run_precision
     from .runner import prepare_output
 
     sc = scene_mod.load(args.scene)  # validate first: a bad scene is a one-line error
+    # Every run of the ladder is checked before the first starts (a factor of 1e-30 would
+    # otherwise be refused only when its turn comes, or never end).
+    duration = kinds.get(sc.analysis["kind"]).PRECISION_DURATION
+    dts = ladder(sc, args.factors or DEFAULT_FACTORS)
+    if not dts:
+        raise SceneError(f"--factors: no time step of the ladder is below 0.9 of the stability limit "
+                         f"({0.9 * sc.critical_dt():.3g} s = {0.9 * sc.critical_dt() / sc.dt:.3g} x the scene's dt)")
+    for dt in dts:
+        try:
+            scene_mod.load(args.scene, dt=dt, duration=duration)
+        except SceneError as e:
+            raise SceneError(f"--factors {dt / sc.dt:g} (dt = {dt:.3g} s): {e}") from None
     out = prepare_output(args.out or Path("precision") / sc.name)
     csv_path, orders = run_precision(args.scene, args.engines, out, args.factors and tuple(args.factors),
                                      progress=not args.quiet, reference=args.reference,

@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -30,8 +30,13 @@ def prepare_output(out_dir) -> Path:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise SceneError(f"--out {out}: cannot be made ({e.strerror})") from None
-    if not os.access(out, os.W_OK | os.X_OK):
-        raise SceneError(f"--out {out}: not writable")
+    # Write a file to know: os.access says yes to root everywhere (/sys, /proc), and the
+    # results are written only after the run.
+    try:
+        with tempfile.TemporaryFile(dir=out):
+            pass
+    except OSError as e:
+        raise SceneError(f"--out {out}: not writable ({e.strerror})") from None
     return out
 
 
@@ -60,7 +65,7 @@ def run_scene(scene, engine, out_dir, progress=True):
     if bad:
         row = int(np.flatnonzero(~np.isfinite(df[bad[0]].to_numpy(float)))[0])
         raise EngineError(f"{engine}: non-finite {bad[0]} at t = {df['t'].iloc[row]:g} s (the run diverged)")
-    df.to_csv(out_dir / "timeseries.csv", index=False)
+    _write(out_dir / "timeseries.csv", lambda p: df.to_csv(p, index=False))
     summary = {
         "scene": scene.name, "engine": engine, "law": scene.contact.law, "reset": scene.contact.reset,
         "slip_timing": scene.contact.slip_timing, "dt_s": scene.dt, "steps": int(result.steps),
@@ -69,10 +74,19 @@ def run_scene(scene, engine, out_dir, progress=True):
     summary.update(analysis.summarise(scene, df))
     notes = list(result.notes) + analysis.warnings(scene, summary)
     summary["notes"] = notes
-    (out_dir / "summary.json").write_text(json.dumps(summary, indent=2, default=_plain) + "\n")
+    _write(out_dir / "summary.json", lambda p: p.write_text(json.dumps(summary, indent=2, default=_plain) + "\n"))
     for note in notes:
         sys.stderr.write(f"stickslip: warning: {note}\n")
     return summary, df
+
+
+def _write(path, write):
+    """Write a result file; a full disk (or a folder that stopped being writable during
+    the run) is one line, not a traceback."""
+    try:
+        write(path)
+    except OSError as e:
+        raise EngineError(f"cannot write {path}: {e.strerror or e}") from None
 
 
 def _plain(v):

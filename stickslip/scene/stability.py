@@ -34,12 +34,12 @@ def stability_limits(scene) -> dict:
     nu_n = c.nu_n if eff["normal_damping"] else 0.0
     nu_s = c.nu_s if eff["tangential_damping"] else 0.0
     limits = {"normal": _oscillator_limit(c.kn, nu_n, m_eff),
-              "impact": math.pi / math.sqrt(c.kn / m_eff) / IMPACT_STEPS}
+              "impact": _ratio(math.pi, math.sqrt(c.kn / m_eff) * IMPACT_STEPS)}
     if c.law in ("stick_slip", "visco_elastic"):
         limits["tangential"] = _oscillator_limit(c.ks, nu_s, m_eff / turn)
     elif nu_s > 0:
         # A pure dashpot (visco-plastic, Coulomb's regularisation) is explicitly stable for dt < 2 m / nu_s.
-        limits["tangential"] = 2.0 * m_eff / (turn * nu_s)
+        limits["tangential"] = _ratio(2.0 * m_eff, turn * nu_s)
     return limits
 
 
@@ -49,6 +49,15 @@ def critical_dt(scene) -> float:
 
 
 def _oscillator_limit(k, nu, m):
+    """(2/w)(sqrt(1 + zeta^2) - zeta), written so that extreme (finite, positive) inputs
+    give 0 or inf instead of raising: sqrt(1 + z^2) - z = 1/(sqrt(1 + z^2) + z)."""
     w = math.sqrt(k / m)
-    zeta = nu / (2.0 * math.sqrt(k * m))
-    return 2.0 / w * (math.sqrt(1.0 + zeta**2) - zeta)
+    zeta = _ratio(nu, 2.0 * math.sqrt(k) * math.sqrt(m))
+    return _ratio(2.0, w) / (math.sqrt(1.0 + zeta * zeta) + zeta)
+
+
+def _ratio(a, b):
+    """a / b for a >= 0, b >= 0, with a / 0 = inf (0 / 0 = 0): a limit that does not bind."""
+    if b == 0:
+        return math.inf if a > 0 else 0.0
+    return a / b
