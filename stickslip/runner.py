@@ -17,8 +17,11 @@ from . import adapters, analysis, columns
 from .errors import EngineError, SceneError
 from .progress import bar
 
-# Runs bigger than this (steps x grains) are announced before they start.
+# Runs bigger than this (steps x grains) are announced before they start (pyref does
+# ~5e5 grain-steps/s: minutes), and so are time series bigger than this many values
+# (rows x columns: ~2 GB of CSV). The absurd is refused by the reader (MAX_* there).
 ANNOUNCE_GRAIN_STEPS = 1e8
+ANNOUNCE_RECORDED = 1e8
 
 
 def prepare_output(out_dir) -> Path:
@@ -49,9 +52,10 @@ def run_scene(scene, engine, out_dir, progress=True):
         raise EngineError(f"engine {engine} is not available: {reason}")
     out_dir = prepare_output(out_dir)
     size = scene.steps * len(scene.grains)
-    if size > ANNOUNCE_GRAIN_STEPS:
+    rows, cols = scene.steps // scene.output.every + 1, len(columns.names(scene))
+    if size > ANNOUNCE_GRAIN_STEPS or rows * cols > ANNOUNCE_RECORDED:
         sys.stderr.write(f"stickslip: {scene.name} on {engine}: {scene.steps:,} steps x {len(scene.grains):,} "
-                         f"grains = {size:.2g} grain-steps\n")
+                         f"grains = {size:.2g} grain-steps; time series {rows:,} rows x {cols} columns\n")
     label = f"{scene.name} [{engine}, {scene.contact.law}, {scene.contact.slip_timing}]"
     with bar(label, scene.steps, enabled=progress) as update:
         try:
