@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from . import adapters, analysis, columns
+from . import scene as scene_mod
 from .errors import EngineError, SceneError
 from .progress import bar
 
@@ -76,7 +77,7 @@ def run_scene(scene, engine, out_dir, progress=True):
         "wall_time_s": float(result.wall_time_s), "dimension": scene.dimension, "effects": scene.effects,
     }
     summary.update(analysis.summarise(scene, df))
-    notes = list(result.notes) + analysis.warnings(scene, summary)
+    notes = list(result.notes) + scene_mod.accuracy_warnings(scene) + analysis.warnings(scene, summary)
     summary["notes"] = notes
     _write(out_dir / "summary.json", lambda p: p.write_text(json.dumps(summary, indent=2, default=_plain) + "\n"))
     for note in notes:
