@@ -389,6 +389,11 @@ def file_cases():
     yield Case("duplicate key", ["case.toml", "TOML"], raw=b'name = "a"\nname = "b"\n')
     yield Case("truncated", ["case.toml", "TOML"], raw=scene_mod.find("drag").read_bytes()[:300])
     yield Case("UTF-16", ["case.toml"], raw=scene_mod.find("drag").read_text().encode("utf-16"))
+    for depth in (10**5, 3000, 300, 100):  # nested past the parser's recursion, and within it
+        yield Case(f"arrays nested {depth} deep", ["case.toml", "name"],
+                   raw=b"name = " + b"[" * depth + b"]" * depth + b"\n")
+        yield Case(f"tables nested {depth} deep", ["case.toml", "dimension"],
+                   raw=b'name = "x"\ndimension = ' + b"{a = " * depth + b"1" + b"}" * depth + b"\n")
 
 
 def misspelt_cases():
@@ -430,6 +435,44 @@ def double_cases(rng, n):
         except AssertionError:
             continue  # the second mutation replaced the first one's table
         out.append(Case(f"{c1.what} + {c2.what}", c1.expect + c2.expect, d, command=rng.choice(["run", "precision"])))
+    return out
+
+
+def odd_cases(rng, sample=None):
+    """Valid but unusual scenes, cut to 20 steps, to be run for real on pyref: output lists
+    empty, reversed, at odd intervals; every law, reset and timing; spin; extreme numbers.
+    Each must run (exit 0, only `stickslip:` lines on stderr) or be refused in one line."""
+    out = []
+    for base_name, base in BASES.items():
+        short = copy.deepcopy(base)
+        short["time"]["duration"] = short["time"]["dt"] * 20
+        short["output"]["every"] = 1
+        variants = {
+            "no output": {"output": {}},
+            "every 7": {"output": {**short["output"], "every": 7}},
+            "every 20": {"output": {**short["output"], "every": 20}},
+            "stats and energy": {"output": {**short["output"], "stats": True, "energy": True}},
+            "one step": {"time": {**short["time"], "duration": short["time"]["dt"]}},
+            "spin": {"effects": {**short["effects"], "rotation": True}},
+        }
+        for law in ("coulomb", "visco_plastic", "visco_elastic"):
+            variants[f"law {law}"] = {"contact": {**short["contact"], "law": law}}
+        variants["reset total, exact"] = {"contact": {**short["contact"], "reset": "total", "slip_timing": "exact"}}
+        pairs = [c for c in short["output"].get("contacts", []) if c[1] in {g["name"] for g in short["grain"]}]
+        if pairs:
+            variants["reversed pair"] = {"output": {**short["output"], "contacts": [pairs[0][::-1]]},
+                                         "analysis": {"kind": "none"}}
+        for what, change in variants.items():
+            d = copy.deepcopy(short)
+            d.update(copy.deepcopy(change))
+            out.append(Case(f"{base_name}: {what}", [""], d, may_pass=True))
+        for c in extreme_cases(base_name):
+            c.data["time"]["duration"] = c.data["time"]["dt"] * 20
+            c.data["output"]["every"] = 1
+            out.append(c)
+    if sample is not None:
+        keep = [c for c in out if "=" not in c.what]  # every variant, a sample of the extreme values
+        out = keep + rng.sample([c for c in out if "=" in c.what], sample)
     return out
 
 
@@ -624,6 +667,42 @@ def test_fuzz_scenes_all(standins, tmp_path):
     """Every value mutation of every base, and 3000 random double mutations (opt-in)."""
     rng = random.Random(SEED)
     run_scene_cases(scene_cases(rng) + double_cases(rng, 3000), tmp_path, "scene fuzz, full")
+
+
+def run_for_real(cases, root):
+    """Each case through cli.main on pyref: it runs (exit 0, stderr only `stickslip:`
+    warnings) or is refused in one line (exit 1 or 2); nothing written outside its --out."""
+    failures = []
+    for i, c in enumerate(cases):
+        path = root / "case.toml"
+        path.write_text(dump(c.data))
+        out = root / "out" / str(i)
+        status, _, err, new = call(["run", str(path), "--quiet", "--out", str(out)], root)
+        outside = [p for p in new if not p.startswith("out")]
+        lines = err.splitlines()
+        if status == 0:
+            why = None if all(x.startswith("stickslip: ") for x in lines) else f"stderr {err[:300]!r}"
+        elif status in (1, 2):
+            ok = len(lines) == 1 and lines[0].startswith("stickslip: error: ")
+            why = None if ok else f"exit {status}, stderr {err[:300]!r}"
+        else:
+            why = f"exit status {status!r}; stderr {err[:300]!r}"
+        if outside:
+            why = f"wrote {outside[:5]}"
+        if why:
+            failures.append(f"{c.what}: {why}")
+    assert not failures, f"{len(failures)} of {len(cases)} runs failed (seed {SEED}):\n" + "\n".join(failures[:40])
+
+
+def test_fuzz_odd_scenes_run_on_pyref(tmp_path):
+    """Valid but unusual scenes run for 20 steps on pyref, for real: no traceback after
+    the scene was accepted (the analysis of a short run, odd outputs, extreme numbers)."""
+    run_for_real(odd_cases(random.Random(SEED), sample=30), tmp_path)
+
+
+@pytest.mark.slow
+def test_fuzz_odd_scenes_run_on_pyref_all(tmp_path):
+    run_for_real(odd_cases(random.Random(SEED)), tmp_path)
 
 
 @pytest.mark.parametrize("argv,words", [

@@ -51,6 +51,10 @@ MAX_MAGNITUDE = 1e100
 # effective mass) and their ratios to a stiffness stay inside double precision.
 MASS_RANGE = (1e-100, 1e100)
 
+# A scene file larger than this is refused unread: TOML parses at ~2 MB/s here (10^5
+# [[grain]] tables, 8.7 MB: 3.8 s), so 64 MB is half a minute; many grains go in a lattice.
+MAX_SCENE_BYTES = 64 << 20
+
 # Overrides by name -> (table, key) in the scene file.
 _OVERRIDES = {"dt": ("time", "dt"), "duration": ("time", "duration"), "every": ("output", "every"),
               **{k: ("contact", k) for k in ("law", "kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k", "reset",
@@ -76,13 +80,21 @@ def load(name_or_path, **overrides) -> Scene:
     `effect_<name>=bool`."""
     path = find(name_or_path)
     try:
-        data = tomllib.loads(path.read_bytes().decode("utf-8"))
+        with open(path, "rb") as f:
+            raw = f.read(MAX_SCENE_BYTES + 1)  # no more: a scene path may name any file
+    except OSError as e:
+        raise SceneError(f"{path}: cannot be read ({e.strerror})") from None
+    if len(raw) > MAX_SCENE_BYTES:
+        raise SceneError(f"{path}: not a scene file (over {MAX_SCENE_BYTES >> 20} MB; many grains go in a "
+                         f"[[lattice]])")
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
     except UnicodeDecodeError:
         raise SceneError(f"{path}: not a scene file (not UTF-8 text; scenes are TOML)") from None
     except tomllib.TOMLDecodeError as e:
         raise SceneError(f"{path}: not valid TOML ({e})") from None
-    except OSError as e:
-        raise SceneError(f"{path}: cannot be read ({e.strerror})") from None
+    except RecursionError:
+        raise SceneError(f"{path}: not a scene file (arrays or tables nested too deeply)") from None
     return parse(data, source=path, overrides=overrides)
 
 
@@ -167,6 +179,13 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
         if moving and not effects["moving_walls"]:
             raise SceneError(f"wall[{i}] ({wall.name}) moves: set effects.moving_walls = true")
         walls.append(wall)
+    for i, w in enumerate(walls):
+        r = w.rotation
+        if r is not None:  # the turn is counted in steps (Scene.rotation_steps): it must be a number of them
+            turn = r.stop_angle / (r.rate * dt) if r.rate * dt > 0 else math.inf
+            if not turn <= MAX_STEPS:
+                raise SceneError(f"wall[{i}].rotation.rate = {r.rate:g} rad/s: at dt = {dt:g} s it reaches "
+                                 f"stop_angle = {r.stop_angle:g} rad after {turn:.3g} steps; at most {MAX_STEPS:.0e}")
     _unique([g.name for g in grains] + [w.name for w in walls], "grain/wall name")
     _check_start(grains, walls, dim)
 
@@ -249,10 +268,14 @@ def _output(ot, grains, walls) -> Output:
         energy=ot.boolean("energy", False),
     )
     ot.done()
+    seen = set()
     for pair in output.contacts:
         if (not isinstance(pair, list) or len(pair) != 2 or pair[0] not in gnames
                 or pair[1] not in gnames | wnames or pair[0] == pair[1]):
-            raise SceneError(f"output.contacts: {pair!r} must be [grain, other grain or wall]")
+            raise SceneError(f"output.contacts: {_shown(pair)} must be [grain, other grain or wall]")
+        if frozenset(pair) in seen:  # [a, b] and [b, a] are one contact
+            raise SceneError(f"output.contacts: {pair!r} is recorded twice (each contact once)")
+        seen.add(frozenset(pair))
     return output
 
 
@@ -385,11 +408,13 @@ class _Table:
         return v
 
     def names(self, k, known, what):
-        """A list of names, each one of `known`."""
+        """A list of names, each one of `known`, each once (a name twice would give its
+        columns twice)."""
         v = self.array(k)
         for x in v:
             if not isinstance(x, str) or x not in known:
                 raise SceneError(f"{self.key(k)}: {_shown(x)} is not {what}")
+        _unique(v, self.key(k))
         return list(v)
 
     def done(self):
