@@ -308,3 +308,22 @@ def test_non_finite_time_series_is_one_line_and_status_1(monkeypatch, tmp_path, 
     assert status == 1
     assert capsys.readouterr().err == "stickslip: error: pyref: non-finite grain-floor_fn at t = 1.4e-05 s (the run diverged)\n"
     assert not (tmp_path / "o" / "summary.json").exists()
+
+
+def test_a_fault_of_ours_is_one_line_and_status_1(monkeypatch, tmp_path, capsys):
+    """Anything unforeseen (here a ZeroDivisionError in the runner) is one line naming the
+    error, exit status 1; STICKSLIP_TRACEBACK=1 lets the traceback through."""
+    from stickslip import cli, runner
+
+    def fault(*a, **k):
+        return 1 / 0
+
+    monkeypatch.setattr(runner, "run_scene", fault)
+    argv = ["run", "drag", "--quiet", "--out", str(tmp_path / "o")]
+    assert cli.main(argv) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("stickslip: error: internal error (ZeroDivisionError: division by zero)") and \
+        err.count("\n") == 1, err
+    monkeypatch.setenv("STICKSLIP_TRACEBACK", "1")
+    with pytest.raises(ZeroDivisionError):
+        cli.main(argv)
