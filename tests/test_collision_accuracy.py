@@ -131,10 +131,12 @@ def test_restitution_error_at_the_threshold_is_what_the_warning_says():
     assert at["equal 5 mm"] < RESTITUTION_ERROR / 3, at
 
 
-def test_warning_for_the_100_to_1_pair_at_0_9_of_the_limit():
-    """The 100:1 pair at 0.9 of the accepted dt is stable but off by far more than the
-    tolerance; it warns once, saying the steps used, the threshold and what to do."""
-    R, r = PAIRS["100:1, zeta 0.66"]
+@pytest.mark.parametrize("pair", ["100:1, zeta 0.66", "100:1, zeta 1.32"])
+def test_warning_for_the_100_to_1_pair_at_0_9_of_the_limit(pair):
+    """A 100:1 pair at 0.9 of the accepted dt is stable but off by far more than the
+    tolerance (measured with 64 phases: 0.14 at zeta 0.66; e = 0.50-0.81 instead of 0.09
+    at zeta 1.32); it warns once, saying the steps used, the threshold and what to do."""
+    R, r = PAIRS[pair]
     sc = pair_scene(R, r)
     sc.dt = 0.9 * sc.critical_dt()
     n = stability.contact_steps(sc)
