@@ -46,8 +46,8 @@ def edit(old, new, text=DRAG):
     ("dimension = 2", "dimension = 2.0", ["dimension", "integer 2"]),
     ("grains = [\"grain\"]", "grains = 5", ["output.grains", "expected a list"]),
     ("every = 1", "every = 1.5", ["output.every", "whole number"]),
-    ("every = 1", "every = 0", ["output.every", "[1, inf]"]),
-    ("every = 1", "every = 2501", ["output.every", "[1, 2500]"]),       # 2500 steps: nothing recorded
+    ("every = 1", "every = 0", ["output.every", "[1, 2147483647]"]),
+    ("every = 1", "every = 2147483648", ["output.every", "[1, 2147483647]"]),  # LIGGGHTS: a 32-bit int
     ("grain = \"grain\"\n", "grain = \"grian\"\n", ["analysis.grain", "grain name"]),
     ("kind = \"drag\"", "kind = \"drag\"\ncolour = 1", ["analysis.colour", "unknown key"]),
     ("kind = \"drag\"", "kind = \"drag\"\nwall = \"floor\"", ["analysis.wall", "unknown key"]),

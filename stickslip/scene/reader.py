@@ -55,6 +55,11 @@ MASS_RANGE = (1e-100, 1e100)
 # [[grain]] tables, 8.7 MB: 3.8 s), so 64 MB is half a minute; many grains go in a lattice.
 MAX_SCENE_BYTES = 64 << 20
 
+# output.every at most this: LIGGGHTS takes a dump interval as a 32-bit int (a larger
+# one is misread there); more than the run's steps records only the start (allowed: a
+# short trial of a scene keeps its interval).
+MAX_EVERY = 2**31 - 1
+
 # Overrides by name -> (table, key) in the scene file.
 _OVERRIDES = {"dt": ("time", "dt"), "duration": ("time", "duration"), "every": ("output", "every"),
               **{k: ("contact", k) for k in ("law", "kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k", "reset",
@@ -205,9 +210,6 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
                          f"({cause} limit, from the masses, kn, ks and damping; see docs/scene-format.md)")
     if steps < 0.5:
         raise SceneError(f"time.duration = {duration:g} s: shorter than one step (dt = {dt:g} s)")
-    if output.every > scene.steps:
-        raise SceneError(f"output.every = {output.every}: more than the run's {scene.steps} steps (nothing after "
-                         f"t = 0 would be recorded); must be in [1, {scene.steps}]")
     recorded = (scene.steps // output.every + 1) * len(columns.names(scene))
     if recorded > MAX_RECORDED:
         raise SceneError(f"output.every = {output.every}: the time series would hold {recorded:.3g} values "
@@ -260,7 +262,7 @@ def _output(ot, grains, walls) -> Output:
     gnames = {g.name for g in grains}
     wnames = {w.name for w in walls}
     output = Output(
-        every=ot.integer("every", 1, lo=1),
+        every=ot.integer("every", 1, lo=1, hi=MAX_EVERY),
         grains=ot.names("grains", gnames, "a grain name"),
         contacts=ot.array("contacts"),
         walls=ot.names("walls", wnames, "a wall name"),
