@@ -262,7 +262,6 @@ def test_non_finite_run_is_one_line_and_status_1(monkeypatch, tmp_path, capsys):
     """pyref raises FloatingPointError at the first non-finite position or velocity; the
     runner makes it one line, exit status 1, and no summary is written."""
     from pyref import Simulation
-
     from stickslip import cli
 
     step = Simulation.step

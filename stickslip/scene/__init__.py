@@ -11,8 +11,16 @@ from pyref.laws import LAWS, RESETS, SLIP_TIMINGS
 from ..errors import SceneError
 from .model import Contact, Grain, Output, Scene, Wall, WallRotation
 from .reader import CASES_DIR, EFFECTS, MAX_START_OVERLAP, check_contact, find, load, parse
-from .stability import (CONTACT_STEPS, IMPACT_STEPS, RESTITUTION_ERROR, accuracy_warnings, contact_steps,
-                        contact_time, critical_dt, stability_limits)
+from .stability import (
+                        CONTACT_STEPS,
+                        IMPACT_STEPS,
+                        RESTITUTION_ERROR,
+                        accuracy_warnings,
+                        contact_steps,
+                        contact_time,
+                        critical_dt,
+                        stability_limits,
+)
 
 __all__ = ["CASES_DIR", "CONTACT_STEPS", "EFFECTS", "IMPACT_STEPS", "LAWS", "MAX_START_OVERLAP", "RESETS",
            "RESTITUTION_ERROR", "SLIP_TIMINGS", "Contact", "Grain", "Output", "Scene", "SceneError", "Wall",

@@ -88,11 +88,12 @@ def accuracy_warnings(scene) -> list:
     if n >= CONTACT_STEPS:
         return []
     t = contact_time(scene)
-    return [f"contacts are resolved by {n:.3g} steps (dt = {scene.dt:g} s; contact time {t:.3g} s = "
+    text = (f"contacts are resolved by {n:.3g} steps (dt = {scene.dt:g} s; contact time {t:.3g} s = "
             f"min(pi*sqrt(m/kn), 4*pi*m/nu_n) of the lightest contact, m = {lightest_contact_mass(scene):.3g}): "
             f"with fewer than {CONTACT_STEPS} steps per contact the restitution of an impact can be off by more "
             f"than {RESTITUTION_ERROR:g} of the impact speed (measured on pyref), although the run is stable. "
-            f"For accurate collisions use dt <= {t / CONTACT_STEPS:.3g} s (docs/scene-format.md)"]
+            f"For accurate collisions use dt <= {t / CONTACT_STEPS:.3g} s (docs/scene-format.md)")
+    return [text]
 
 
 def critical_dt(scene) -> float:
