@@ -2,13 +2,15 @@
 
 run -> runner.py, precision -> precision.py, thresholds -> thresholds.py,
 bench -> bench.py, report -> report.py. Bad arguments or a bad scene: one line on
-stderr, exit status 2; an engine that fails: one line, exit status 1.
+stderr, exit status 2; an engine that fails, a file that cannot be written, or a fault of
+ours: one line, exit status 1 (STICKSLIP_TRACEBACK=1 shows the traceback of a fault).
 """
 from __future__ import annotations
 
 import argparse
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -45,6 +47,13 @@ def _count(text):
     return v
 
 
+def _folder(text):
+    """An output folder; an empty one would silently be the current folder."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; give a folder")
+    return Path(text)
+
+
 def build_parser():
     p = _Parser(prog="stickslip", description="Stick-slip friction (Khellaf & Mansouri 2024) on DEM engines.")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -59,7 +68,7 @@ def build_parser():
     r.add_argument("--slip-timing", choices=scene_mod.SLIP_TIMINGS, dest="slip_timing",
                    help="step: slip tested at the end of each step (the paper); exact: each slip at its "
                         "time inside the step (docs/law.md); default: the scene's")
-    r.add_argument("--out", type=Path, help="output folder (default: runs/SCENE/ENGINE)")
+    r.add_argument("--out", type=_folder, help="output folder (default: runs/SCENE/ENGINE)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
 
     pr = sub.add_parser("precision", help="error vs wall time over a ladder of time steps")
@@ -71,19 +80,19 @@ def build_parser():
                     default=list(scene_mod.SLIP_TIMINGS), help="modes to run (default: both)")
     pr.add_argument("--reference", default="pyref", choices=ENGINES,
                     help="engine whose exact-timing run at the finest step is the reference (default: pyref)")
-    pr.add_argument("--out", type=Path, help="output folder (default: precision/SCENE)")
+    pr.add_argument("--out", type=_folder, help="output folder (default: precision/SCENE)")
     pr.add_argument("--quiet", action="store_true", help="no progress bars")
 
     th = sub.add_parser("thresholds", help="measure the speed above which every step slips, vs the formula")
-    th.add_argument("--out", type=Path, default=Path("thresholds"), help="output folder (default: thresholds)")
+    th.add_argument("--out", type=_folder, default=Path("thresholds"), help="output folder (default: thresholds)")
 
     be = sub.add_parser("bench", help="performance figures (pyref, and engines that provide a benchmark)")
-    be.add_argument("--out", type=Path, default=Path("bench"), help="output folder (default: bench)")
+    be.add_argument("--out", type=_folder, default=Path("bench"), help="output folder (default: bench)")
     be.add_argument("--reps", type=_count, default=3, help="repetitions per figure (median quoted)")
     be.add_argument("--report", action="store_true", help="also time `stickslip report` (all engines and studies)")
 
     rep = sub.add_parser("report", help="run the paper's cases on every available engine; figures + report.md")
-    rep.add_argument("--out", type=Path, default=Path("report"), help="output folder (default: report)")
+    rep.add_argument("--out", type=_folder, default=Path("report"), help="output folder (default: report)")
     rep.add_argument("--engines", nargs="+", choices=ENGINES, help="engines to use (default: every available one)")
     rep.add_argument("--quiet", action="store_true", help="no progress bars")
     rep.add_argument("--no-precision", action="store_true",
@@ -101,9 +110,23 @@ def main(argv=None):
     except EngineError as e:
         sys.stderr.write(f"stickslip: error: {e}\n")
         return 1
+    except OSError as e:  # the file system refused (a full disk, a folder gone during the run)
+        where = f"{e.filename}: " if e.filename else ""
+        sys.stderr.write(f"stickslip: error: {where}{e.strerror or e}\n")
+        return 1
+    except MemoryError:
+        sys.stderr.write("stickslip: error: out of memory (the scene or its output is too big for this "
+                         "machine: fewer grains, a shorter run or a larger output.every)\n")
+        return 1
     except KeyboardInterrupt:
         sys.stderr.write("stickslip: interrupted\n")
         return 130
+    except Exception as e:  # a fault of ours: one line for the user, the traceback on request
+        if os.environ.get("STICKSLIP_TRACEBACK"):
+            raise
+        sys.stderr.write(f"stickslip: error: internal error ({type(e).__name__}: {' '.join(str(e).split())[:200]}); "
+                         f"please report it (STICKSLIP_TRACEBACK=1 shows where)\n")
+        return 1
 
 
 def cmd_run(args):
@@ -120,10 +143,23 @@ def cmd_run(args):
 
 
 def cmd_precision(args):
-    from .precision import run_precision
+    from . import kinds
+    from .precision import DEFAULT_FACTORS, ladder, run_precision
     from .runner import prepare_output
 
     sc = scene_mod.load(args.scene)  # validate first: a bad scene is a one-line error
+    # Every run of the ladder is checked before the first starts (a factor of 1e-30 would
+    # otherwise be refused only when its turn comes, or never end).
+    duration = kinds.get(sc.analysis["kind"]).PRECISION_DURATION
+    dts = ladder(sc, args.factors or DEFAULT_FACTORS)
+    if not dts:
+        raise SceneError(f"--factors: no time step of the ladder is below 0.9 of the stability limit "
+                         f"({0.9 * sc.critical_dt():.3g} s = {0.9 * sc.critical_dt() / sc.dt:.3g} x the scene's dt)")
+    for dt in dts:
+        try:
+            scene_mod.load(args.scene, dt=dt, duration=duration)
+        except SceneError as e:
+            raise SceneError(f"--factors {dt / sc.dt:g} (dt = {dt:.3g} s): {e}") from None
     out = prepare_output(args.out or Path("precision") / sc.name)
     csv_path, orders = run_precision(args.scene, args.engines, out, args.factors and tuple(args.factors),
                                      progress=not args.quiet, reference=args.reference,

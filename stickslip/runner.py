@@ -7,19 +7,23 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
 from . import adapters, analysis, columns
+from . import scene as scene_mod
 from .errors import EngineError, SceneError
 from .progress import bar
 from .scene import load as scene_load
 
-# Runs bigger than this (steps x grains) are announced before they start.
+# Runs bigger than this (steps x grains) are announced before they start (pyref does
+# ~5e5 grain-steps/s: minutes), and so are time series bigger than this many values
+# (rows x columns: ~2 GB of CSV). The absurd is refused by the reader (MAX_* there).
 ANNOUNCE_GRAIN_STEPS = 1e8
+ANNOUNCE_RECORDED = 1e8
 
 
 def prepare_output(out_dir) -> Path:
@@ -31,8 +35,13 @@ def prepare_output(out_dir) -> Path:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise SceneError(f"--out {out}: cannot be made ({e.strerror})") from None
-    if not os.access(out, os.W_OK | os.X_OK):
-        raise SceneError(f"--out {out}: not writable")
+    # Write a file to know: os.access says yes to root everywhere (/sys, /proc), and the
+    # results are written only after the run.
+    try:
+        with tempfile.TemporaryFile(dir=out):
+            pass
+    except OSError as e:
+        raise SceneError(f"--out {out}: not writable ({e.strerror})") from None
     return out
 
 
@@ -45,9 +54,10 @@ def run_scene(scene, engine, out_dir, progress=True):
         raise EngineError(f"engine {engine} is not available: {reason}")
     out_dir = prepare_output(out_dir)
     size = scene.steps * len(scene.grains)
-    if size > ANNOUNCE_GRAIN_STEPS:
+    rows, cols = scene.steps // scene.output.every + 1, len(columns.names(scene))
+    if size > ANNOUNCE_GRAIN_STEPS or rows * cols > ANNOUNCE_RECORDED:
         sys.stderr.write(f"stickslip: {scene.name} on {engine}: {scene.steps:,} steps x {len(scene.grains):,} "
-                         f"grains = {size:.2g} grain-steps\n")
+                         f"grains = {size:.2g} grain-steps; time series {rows:,} rows x {cols} columns\n")
     label = f"{scene.name} [{engine}, {scene.contact.law}, {scene.contact.slip_timing}]"
     with bar(label, scene.steps, enabled=progress) as update:
         try:
@@ -61,19 +71,28 @@ def run_scene(scene, engine, out_dir, progress=True):
     if bad:
         row = int(np.flatnonzero(~np.isfinite(df[bad[0]].to_numpy(float)))[0])
         raise EngineError(f"{engine}: non-finite {bad[0]} at t = {df['t'].iloc[row]:g} s (the run diverged)")
-    df.to_csv(out_dir / "timeseries.csv", index=False)
+    _write(out_dir / "timeseries.csv", lambda p: df.to_csv(p, index=False))
     summary = {
         "scene": scene.name, "engine": engine, "law": scene.contact.law, "reset": scene.contact.reset,
         "slip_timing": scene.contact.slip_timing, "dt_s": scene.dt, "steps": int(result.steps),
         "wall_time_s": float(result.wall_time_s), "dimension": scene.dimension, "effects": scene.effects,
     }
     summary.update(analysis.summarise(scene, df))
-    notes = list(result.notes) + analysis.warnings(scene, summary)
+    notes = list(result.notes) + scene_mod.accuracy_warnings(scene) + analysis.warnings(scene, summary)
     summary["notes"] = notes
-    (out_dir / "summary.json").write_text(json.dumps(summary, indent=2, default=_plain) + "\n")
+    _write(out_dir / "summary.json", lambda p: p.write_text(json.dumps(summary, indent=2, default=_plain) + "\n"))
     for note in notes:
         sys.stderr.write(f"stickslip: warning: {note}\n")
     return summary, df
+
+
+def _write(path, write):
+    """Write a result file; a full disk (or a folder that stopped being writable during
+    the run) is one line, not a traceback."""
+    try:
+        write(path)
+    except OSError as e:
+        raise EngineError(f"cannot write {path}: {e.strerror or e}") from None
 
 
 def _plain(v):

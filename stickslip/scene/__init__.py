@@ -3,15 +3,26 @@
 `load(path_or_name, **overrides)` reads and validates a scene and returns a `Scene`
 (scene/model.py); any problem raises `SceneError` with a one-line message that names
 the key and the allowed range (scene/reader.py), so no engine ever sees an invalid
-scene. The largest stable time step is scene/stability.py. Format: docs/scene-format.md.
+scene. The largest stable time step, and the step below which collisions are accurate,
+are scene/stability.py. Format: docs/scene-format.md.
 """
 from pyref.laws import LAWS, RESETS, SLIP_TIMINGS
 
 from ..errors import SceneError
 from .model import Contact, Grain, Output, Scene, Wall, WallRotation
 from .reader import CASES_DIR, EFFECTS, MAX_START_OVERLAP, check_contact, find, load, parse
-from .stability import IMPACT_STEPS, critical_dt, stability_limits
+from .stability import (
+                        CONTACT_STEPS,
+                        IMPACT_STEPS,
+                        RESTITUTION_ERROR,
+                        accuracy_warnings,
+                        contact_steps,
+                        contact_time,
+                        critical_dt,
+                        stability_limits,
+)
 
-__all__ = ["CASES_DIR", "EFFECTS", "IMPACT_STEPS", "LAWS", "MAX_START_OVERLAP", "RESETS", "SLIP_TIMINGS",
-           "Contact", "Grain", "Output", "Scene", "SceneError", "Wall", "WallRotation", "check_contact",
-           "critical_dt", "find", "load", "parse", "stability_limits"]
+__all__ = ["CASES_DIR", "CONTACT_STEPS", "EFFECTS", "IMPACT_STEPS", "LAWS", "MAX_START_OVERLAP", "RESETS",
+           "RESTITUTION_ERROR", "SLIP_TIMINGS", "Contact", "Grain", "Output", "Scene", "SceneError", "Wall",
+           "WallRotation", "accuracy_warnings", "check_contact", "contact_steps", "contact_time", "critical_dt",
+           "find", "load", "parse", "stability_limits"]

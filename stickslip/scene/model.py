@@ -12,6 +12,15 @@ from pyref.laws import LawParams
 from . import stability
 
 
+def mass(dim, radius, density) -> float:
+    """Disk mass per unit thickness in 2D (the paper's convention), sphere mass in 3D.
+    (The reader bounds radius and density to 1e100, so the powers cannot overflow; the
+    product can reach inf or 0, which the reader refuses.)"""
+    if dim == 2:
+        return density * math.pi * radius**2
+    return density * 4.0 / 3.0 * math.pi * radius**3
+
+
 @dataclass
 class Contact:
     law: str
@@ -91,10 +100,7 @@ class Scene:
         return int(round(self.duration / self.dt))
 
     def grain_mass(self, g: Grain) -> float:
-        """Disk mass per unit thickness in 2D (the paper's convention), sphere mass in 3D."""
-        if self.dimension == 2:
-            return g.density * math.pi * g.radius**2
-        return g.density * 4.0 / 3.0 * math.pi * g.radius**3
+        return mass(self.dimension, g.radius, g.density)
 
     def grain_inertia(self, g: Grain) -> float:
         m = self.grain_mass(g)

@@ -15,9 +15,9 @@ import numpy as np
 
 from pyref.laws import LAWS, RESETS, SLIP_TIMINGS, LawParams
 
-from .. import kinds
+from .. import columns, kinds
 from ..errors import SceneError
-from .model import Contact, Grain, Output, Scene, Wall, WallRotation
+from .model import Contact, Grain, Output, Scene, Wall, WallRotation, mass
 from .stability import stability_limits
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
@@ -32,6 +32,33 @@ MAX_START_OVERLAP = 0.1
 # More steps than this is refused: at a microsecond per step it would run for 3 hours
 # per grain, and it is almost always a mistyped dt or duration.
 MAX_STEPS = 10**10
+# More grains than this is refused before any is made: the reader holds ~0.9 kB per grain
+# (measured: 870 MB for 10^6), so 10^7 grains need ~9 GB before an engine starts.
+MAX_GRAINS = 10**7
+# More grain-steps (steps x grains) than this is refused: LIGGGHTS, the fastest engine
+# here, does ~6e6 grain-steps/s per core (liggghts_plugin/doc: 20 800 grains, 3.55 ms per
+# step), so 10^13 is ~20 core-days (pyref, ~5e5/s: ~8 months).
+MAX_GRAIN_STEPS = 10**13
+# More recorded values (rows x columns of the time series) than this is refused: 8 GB
+# as float64 in memory and ~20 GB of timeseries.csv. Raise output.every instead.
+MAX_RECORDED = 10**9
+# Numbers in a scene are at most this in magnitude. SI values of a DEM scene are far
+# inside it, and it keeps sums and products of a few of them (masses, distances,
+# stiffness over mass) inside double precision (1.8e308) instead of overflowing.
+MAX_MAGNITUDE = 1e100
+# A grain's mass (kg, or kg/m in 2D) must lie in this range: a nanometre grain weighs
+# 1e-23 kg, so SI scenes are far inside, and the product of two masses (the pair's
+# effective mass) and their ratios to a stiffness stay inside double precision.
+MASS_RANGE = (1e-100, 1e100)
+
+# A scene file larger than this is refused unread: TOML parses at ~2 MB/s here (10^5
+# [[grain]] tables, 8.7 MB: 3.8 s), so 64 MB is half a minute; many grains go in a lattice.
+MAX_SCENE_BYTES = 64 << 20
+
+# output.every at most this: LIGGGHTS takes a dump interval as a 32-bit int (a larger
+# one is misread there); more than the run's steps records only the start (allowed: a
+# short trial of a scene keeps its interval).
+MAX_EVERY = 2**31 - 1
 
 # Overrides by name -> (table, key) in the scene file.
 _OVERRIDES = {"dt": ("time", "dt"), "duration": ("time", "duration"), "every": ("output", "every"),
@@ -58,13 +85,21 @@ def load(name_or_path, **overrides) -> Scene:
     `effect_<name>=bool`."""
     path = find(name_or_path)
     try:
-        data = tomllib.loads(path.read_bytes().decode("utf-8"))
+        with open(path, "rb") as f:
+            raw = f.read(MAX_SCENE_BYTES + 1)  # no more: a scene path may name any file
+    except OSError as e:
+        raise SceneError(f"{path}: cannot be read ({e.strerror})") from None
+    if len(raw) > MAX_SCENE_BYTES:
+        raise SceneError(f"{path}: not a scene file (over {MAX_SCENE_BYTES >> 20} MB; many grains go in a "
+                         f"[[lattice]])")
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
     except UnicodeDecodeError:
         raise SceneError(f"{path}: not a scene file (not UTF-8 text; scenes are TOML)") from None
     except tomllib.TOMLDecodeError as e:
-        raise SceneError(f"{path.name}: not valid TOML ({e})") from None
-    except OSError as e:
-        raise SceneError(f"{path}: cannot be read ({e.strerror})") from None
+        raise SceneError(f"{path}: not valid TOML ({e})") from None
+    except RecursionError:
+        raise SceneError(f"{path}: not a scene file (arrays or tables nested too deeply)") from None
     return parse(data, source=path, overrides=overrides)
 
 
@@ -93,10 +128,27 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
     dt = tt.number("dt", required=True, lo=0, lo_open=True)
     duration = tt.number("duration", required=True, lo=0, lo_open=True)
     tt.done()
+    steps = duration / dt  # may be inf (a subnormal dt): refused below
+    if steps > MAX_STEPS:
+        raise SceneError(f"time.duration / time.dt = {steps:.3g} steps: must be <= {MAX_STEPS:.0e} "
+                         f"(duration {duration:g} s at dt {dt:g} s; is one of them mistyped?)")
+
+    # The size of the run is checked before any grain is made: a huge lattice is refused
+    # at once instead of filling the memory first.
+    grain_tables = [_Table(g, f"grain[{i}]") for i, g in enumerate(top.array("grain"))]
+    lattices = [_Table(b, f"lattice[{i}]") for i, b in enumerate(top.array("lattice"))]
+    counts = [_counts(bt, dim) for bt in lattices]
+    n_grains = len(grain_tables) + sum(math.prod(c) for c in counts)
+    if n_grains > MAX_GRAINS:
+        raise SceneError(f"grain, lattice[].counts: {n_grains:.3g} grains; at most {MAX_GRAINS:.0e} per scene "
+                         f"(the scene alone would need ~{n_grains * 0.9e3 / 1e9:.0f} GB)")
+    if n_grains * steps > MAX_GRAIN_STEPS:
+        raise SceneError(f"time.duration / time.dt x grains = {steps:.3g} steps x {n_grains} grains = "
+                         f"{n_grains * steps:.3g} grain-steps; at most {MAX_GRAIN_STEPS:.0e} (~20 core-days on "
+                         f"LIGGGHTS, the fastest engine here)")
 
     grains = []
-    for i, g in enumerate(top.array("grain")):
-        gt = _Table(g, f"grain[{i}]")
+    for i, gt in enumerate(grain_tables):
         grains.append(Grain(
             name=gt.string("name", f"g{i}"),
             radius=gt.number("radius", required=True, lo=0, lo_open=True),
@@ -106,9 +158,10 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
             imposed=_axes(gt, "imposed", dim),
             angular_velocity=_spin(gt, dim, effects["rotation"]),
         ))
+        _check_mass(gt.where, dim, grains[-1].radius, grains[-1].radius, grains[-1].density)
         gt.done()
-    for i, b in enumerate(top.array("lattice")):
-        grains.extend(_lattice(_Table(b, f"lattice[{i}]"), dim, len(grains)))
+    for bt, c in zip(lattices, counts):
+        grains.extend(_lattice(bt, dim, len(grains), c))
     if not grains:
         raise SceneError("grain: a scene needs at least one [[grain]] or [[lattice]]")
     _unique([g.name for g in grains], "grain.name")
@@ -131,6 +184,13 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
         if moving and not effects["moving_walls"]:
             raise SceneError(f"wall[{i}] ({wall.name}) moves: set effects.moving_walls = true")
         walls.append(wall)
+    for i, w in enumerate(walls):
+        r = w.rotation
+        if r is not None:  # the turn is counted in steps (Scene.rotation_steps): it must be a number of them
+            turn = r.stop_angle / (r.rate * dt) if r.rate * dt > 0 else math.inf
+            if not turn <= MAX_STEPS:
+                raise SceneError(f"wall[{i}].rotation.rate = {r.rate:g} rad/s: at dt = {dt:g} s it reaches "
+                                 f"stop_angle = {r.stop_angle:g} rad after {turn:.3g} steps; at most {MAX_STEPS:.0e}")
     _unique([g.name for g in grains] + [w.name for w in walls], "grain/wall name")
     _check_start(grains, walls, dim)
 
@@ -148,12 +208,12 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
     if dt > limits[cause]:
         raise SceneError(f"time.dt = {dt:.3g} s: above the stability limit; must be <= {limits[cause]:.3g} s "
                          f"({cause} limit, from the masses, kn, ks and damping; see docs/scene-format.md)")
-    steps = duration / dt
     if steps < 0.5:
         raise SceneError(f"time.duration = {duration:g} s: shorter than one step (dt = {dt:g} s)")
-    if steps > MAX_STEPS:
-        raise SceneError(f"time.duration / time.dt = {steps:.3g} steps: must be <= {MAX_STEPS:.0e} "
-                         f"(duration {duration:g} s at dt {dt:g} s; is one of them mistyped?)")
+    recorded = (scene.steps // output.every + 1) * len(columns.names(scene))
+    if recorded > MAX_RECORDED:
+        raise SceneError(f"output.every = {output.every}: the time series would hold {recorded:.3g} values "
+                         f"(rows x columns); at most {MAX_RECORDED:.0e} (~20 GB of CSV): record less often")
     return scene
 
 
@@ -202,7 +262,7 @@ def _output(ot, grains, walls) -> Output:
     gnames = {g.name for g in grains}
     wnames = {w.name for w in walls}
     output = Output(
-        every=ot.integer("every", 1, lo=1),
+        every=ot.integer("every", 1, lo=1, hi=MAX_EVERY),
         grains=ot.names("grains", gnames, "a grain name"),
         contacts=ot.array("contacts"),
         walls=ot.names("walls", wnames, "a wall name"),
@@ -210,10 +270,14 @@ def _output(ot, grains, walls) -> Output:
         energy=ot.boolean("energy", False),
     )
     ot.done()
+    seen = set()
     for pair in output.contacts:
         if (not isinstance(pair, list) or len(pair) != 2 or pair[0] not in gnames
                 or pair[1] not in gnames | wnames or pair[0] == pair[1]):
-            raise SceneError(f"output.contacts: {pair!r} must be [grain, other grain or wall]")
+            raise SceneError(f"output.contacts: {_shown(pair)} must be [grain, other grain or wall]")
+        if frozenset(pair) in seen:  # [a, b] and [b, a] are one contact
+            raise SceneError(f"output.contacts: {pair!r} is recorded twice (each contact once)")
+        seen.add(frozenset(pair))
     return output
 
 
@@ -228,20 +292,42 @@ def _check_start(grains, walls, dim):
             raise SceneError(f"grain {grains[i].name!r} starts {where} wall {w.name!r} (centre {dist[i]:.3g} m "
                              f"from it, radius {r[i]:.3g} m): a grain may start overlapping a wall by at most "
                              f"{MAX_START_OVERLAP:g} of its radius")
-    if len(grains) < 2:
-        return
-    if len(grains) <= 64:
-        a, b = np.triu_indices(len(grains), 1)
-    else:
-        from scipy.spatial import cKDTree
-
-        a, b = cKDTree(x[:, :dim]).query_pairs(2 * r.max(), output_type="ndarray").T
+    a, b = _near_pairs(x[:, :dim], r)
     gap = np.linalg.norm(x[a] - x[b], axis=1) - (r[a] + r[b])
     bad = np.flatnonzero(gap < -MAX_START_OVERLAP * np.minimum(r[a], r[b]))
     if len(bad):
         i, j = a[bad[0]], b[bad[0]]
         raise SceneError(f"grains {grains[i].name!r} and {grains[j].name!r} start overlapping by "
                          f"{-gap[bad[0]]:.3g} m: at most {MAX_START_OVERLAP:g} of the smaller radius")
+
+
+def _near_pairs(x, r):
+    """Index arrays (a, b) of every pair of grains whose centres are closer than the sum of
+    their radii (and some more). A search radius set by the largest grain for all of them
+    would make one big grain among many small ones quadratic (9e4 grains of 0.1 mm and
+    one of 2 mm: 4 GB and 25 s), so the
+    grains are binned by radius in factors of 2 and each bin is searched with its own
+    largest radius, against itself and against the bins of larger grains."""
+    n = len(r)
+    if n <= 64:
+        a, b = np.triu_indices(n, 1)
+        return a, b
+    from scipy.spatial import cKDTree
+
+    level = np.floor(np.log2(r / r.min())).astype(int)
+    bins = [np.flatnonzero(level == k) for k in np.unique(level)]
+    trees = [cKDTree(x[i]) for i in bins]
+    a, b = [], []
+    for k, (ik, tk) in enumerate(zip(bins, trees)):
+        rk = r[ik].max()
+        p = tk.query_pairs(2 * rk, output_type="ndarray")
+        a.append(ik[p[:, 0]])
+        b.append(ik[p[:, 1]])
+        for il, tl in zip(bins[k + 1:], trees[k + 1:]):
+            m = tl.sparse_distance_matrix(tk, r[il].max() + rk, output_type="ndarray")
+            a.append(ik[m["j"]])
+            b.append(il[m["i"]])
+    return np.concatenate(a), np.concatenate(b)
 
 
 class _Table:
@@ -267,8 +353,8 @@ class _Table:
         v = self.get(k, default, required)
         if v is None:
             return None
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise SceneError(f"{self.key(k)}: expected a finite number, got {_shown(v)}")
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not _finite(v):
+            raise SceneError(f"{self.key(k)}: expected a finite number (|x| <= {MAX_MAGNITUDE:g}), got {_shown(v)}")
         v = float(v)
         if lo is not None and (v < lo or (lo_open and v == lo)):
             rng = f"> {lo:g}" if lo_open else f">= {lo:g}"
@@ -309,8 +395,9 @@ class _Table:
         if v is None:
             return None
         if (not isinstance(v, list) or len(v) != dim
-                or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x) for x in v)):
-            raise SceneError(f"{self.key(k)}: expected {dim} finite numbers (dimension = {dim}), got {_shown(v)}")
+                or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and _finite(x) for x in v)):
+            raise SceneError(f"{self.key(k)}: expected {dim} finite numbers (|x| <= {MAX_MAGNITUDE:g}, "
+                             f"dimension = {dim}), got {_shown(v)}")
         out = np.zeros(3)
         out[:dim] = v
         return out
@@ -323,17 +410,27 @@ class _Table:
         return v
 
     def names(self, k, known, what):
-        """A list of names, each one of `known`."""
+        """A list of names, each one of `known`, each once (a name twice would give its
+        columns twice)."""
         v = self.array(k)
         for x in v:
             if not isinstance(x, str) or x not in known:
                 raise SceneError(f"{self.key(k)}: {_shown(x)} is not {what}")
+        _unique(v, self.key(k))
         return list(v)
 
     def done(self):
         unknown = sorted(set(self.data) - self.used)
         if unknown:
             raise SceneError(f"{self.key(unknown[0])}: unknown key")
+
+
+def _finite(v):
+    """A number within MAX_MAGNITUDE (an int too large for a float is not)."""
+    try:
+        return math.isfinite(v) and abs(v) <= MAX_MAGNITUDE
+    except OverflowError:
+        return False
 
 
 def _shown(v):
@@ -380,14 +477,19 @@ def _rotation(wt: _Table, dim, i):
     return rot
 
 
-def _lattice(bt: _Table, dim, start):
-    """A block of grains on a square/cubic lattice, radii spread uniformly (seeded)."""
+def _counts(bt: _Table, dim):
+    """A lattice's grain counts per axis, read before any grain is made (the size check)."""
     counts = bt.get("counts", required=True)
     if (not isinstance(counts, list) or len(counts) != dim
             or not all(isinstance(n, int) and not isinstance(n, bool) and n >= 1 for n in counts)):
         raise SceneError(f"{bt.key('counts')}: expected {dim} positive integers, got {_shown(counts)}")
-    if math.prod(counts) > 10**7:
-        raise SceneError(f"{bt.key('counts')}: {math.prod(counts)} grains; at most 10^7 per lattice")
+    if math.prod(counts) > MAX_GRAINS:
+        raise SceneError(f"{bt.key('counts')}: {math.prod(counts):.3g} grains; at most {MAX_GRAINS:.0e} per scene")
+    return counts
+
+
+def _lattice(bt: _Table, dim, start, counts):
+    """A block of grains on a square/cubic lattice, radii spread uniformly (seeded)."""
     origin = bt.vector("origin", dim, required=True)
     radius = bt.number("radius", required=True, lo=0, lo_open=True)
     spread = bt.number("radius_spread", 0.0, lo=0, hi=0.5)
@@ -398,16 +500,28 @@ def _lattice(bt: _Table, dim, start):
     seed = bt.integer("seed", 0, lo=0)
     prefix = bt.string("prefix", "p")
     bt.done()
-    rng = np.random.default_rng(seed)
-    grains = []
-    for idx in np.ndindex(*counts):
-        pos = origin.copy()
-        pos[:dim] += np.array(idx) * spacing
-        vel = velocity.copy()
-        vel[:dim] += jitter * rng.uniform(-1, 1, dim)
-        r = radius * (1 + spread * rng.uniform(-1, 1))
-        grains.append(Grain(f"{prefix}{start + len(grains)}", r, density, pos, vel))
-    return grains
+    _check_mass(bt.where, dim, radius * (1 - spread), radius * (1 + spread), density)
+    n = math.prod(counts)
+    # One draw per grain of `dim` jitter components then one radius factor, in grain
+    # order: the same numbers as drawing them grain by grain (the scenes stay the same).
+    u = np.random.default_rng(seed).uniform(-1, 1, (n, dim + 1))
+    pos = np.zeros((n, 3))
+    pos[:, :dim] = origin[:dim] + np.indices(counts).reshape(dim, n).T * spacing
+    vel = np.zeros((n, 3))
+    vel[:, :dim] = velocity[:dim] + jitter * u[:, :dim]
+    radii = radius * (1 + spread * u[:, dim])
+    return [Grain(f"{prefix}{start + k}", float(radii[k]), density, pos[k], vel[k]) for k in range(n)]
+
+
+def _check_mass(where, dim, r_min, r_max, density):
+    """A grain's mass must lie within MASS_RANGE (radius and density each within range can
+    still multiply far beyond it)."""
+    lo, hi = MASS_RANGE
+    for r in (r_min, r_max):
+        m = mass(dim, r, density)
+        if not lo <= m <= hi:
+            raise SceneError(f"{where}.radius = {r:g} m with density = {density:g}: mass {m:g}; must be in "
+                             f"[{lo:g}, {hi:g}] (SI units)")
 
 
 def _unique(names, what):
