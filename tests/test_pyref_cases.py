@@ -48,14 +48,20 @@ def test_tray_stick_slip_holds_grain_1():
     sc, df, _ = paper_case("tray", duration=0.5)
     s = analysis.summarise(sc, df)
     assert not s["reached_bottom"]
-    # Held where it first wedged: above the bottom by more than half its fall room
-    # (it first touches grain 2 at 0.2 mm above the bottom).
-    assert s["y1_final_m"] - sc.grains[0].radius > 0.1e-3 * 0.5
+    # Held where it first wedged: above the bottom by more than half its fall room, the
+    # height at which it first touches grain 2 (0.64 mm in cases/tray.toml, held at
+    # 0.62 mm; 0.2 mm in cases/tray_wedge.toml, held at 0.10 mm).
+    g1, g2 = sc.grains[0], sc.grains[1]
+    first_touch = math.sqrt((g1.radius + g2.radius) ** 2 - (g2.position[0] - g1.position[0]) ** 2)
+    assert s["y1_final_m"] - g1.radius > 0.5 * first_touch
     assert s["time_to_rest_s"] is not None and s["time_to_rest_s"] < 0.4
 
 
-# Coulomb creeps down and needs the scene's full 2.5 s; visco-plastic is down in 0.05 s.
-@pytest.mark.parametrize("law,duration", [("coulomb", None), ("visco_plastic", 0.3)])
+# Coulomb creeps down and needs the scene's full duration. Visco-plastic creeps past the
+# height where normal forces carry 99.99 % of its weight and reaches the bottom at
+# 2.643 s (the tray width is calibrated on the paper's 2.65 s, docs/tray-calibration.md):
+# it needs the scene's full 3.0 s too (600 000 steps, 40-60 s on pyref).
+@pytest.mark.parametrize("law,duration", [("coulomb", None), ("visco_plastic", None)])
 def test_tray_coulomb_and_visco_plastic_reach_the_bottom(law, duration):
     sc, df, _ = paper_case("tray", law=law, duration=duration)
     s = analysis.summarise(sc, df)
