@@ -57,20 +57,24 @@ def test_tray_stick_slip_holds_grain_1():
     assert s["time_to_rest_s"] is not None and s["time_to_rest_s"] < 0.4
 
 
-# Coulomb creeps down and needs the scene's full duration. Visco-plastic creeps past the
-# height where normal forces carry 99.99 % of its weight and reaches the bottom at
-# 2.643 s (the tray width is calibrated on the paper's 2.65 s, docs/tray-calibration.md):
-# it needs the scene's full 3.0 s too (600 000 steps, 40-60 s on pyref).
-@pytest.mark.parametrize("law,duration", [("coulomb", None), ("visco_plastic", None)])
-def test_tray_coulomb_and_visco_plastic_reach_the_bottom(law, duration):
-    sc, df, _ = paper_case("tray", law=law, duration=duration)
+# Visco-plastic creeps past the height where normal forces carry 99.99 % of its weight
+# and reaches the bottom at 2.643 s (the tray width is calibrated on the paper's 2.65 s,
+# docs/tray-calibration.md): the scene's full 3.0 s (600 000 steps, 40-60 s on pyref).
+# Coulomb's creep is a time-step effect (its force flips every step): in the calibrated
+# tray it would take ~1100 s; in tray_wedge (2 um narrower than two diameters) it falls
+# within the scene's 2.5 s, as the paper's Fig. 11 shows.
+@pytest.mark.parametrize("case,law", [("tray_wedge", "coulomb"), ("tray", "visco_plastic")])
+def test_tray_coulomb_and_visco_plastic_reach_the_bottom(case, law):
+    sc, df, _ = paper_case(case, law=law)
     s = analysis.summarise(sc, df)
     assert s["reached_bottom"], s
+    if case == "tray":  # the calibration: the paper's 2.65 s within 5 %
+        assert s["t_bottom_s"] == pytest.approx(2.65, rel=0.05)
 
 
 def test_tray_coulomb_force_alternates_sign():
     # Fig. 12a: with Coulomb friction the tangential force flips between +-mu*Fn.
-    sc, df, _ = paper_case("tray", law="coulomb")
+    sc, df, _ = paper_case("tray_wedge", law="coulomb")
     c = "grain1-grain2"
     touching = df[f"{c}_fn"] > 0
     fty = df.loc[touching, f"{c}_fty"].to_numpy()
