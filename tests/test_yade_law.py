@@ -89,7 +89,8 @@ ok = dict(ks=9.6e6, nu_s=33.1, mu_s=0.5, mu_k=0.45)
 out = {}
 for name, kw in [("mu_k_high", {"mu_k": 0.6}), ("mu_k_low", {"mu_k": 0.2}), ("ks_zero", {"ks": 0.0}),
                  ("ks_neg", {"ks": -1.0}), ("nu_s_neg", {"nu_s": -1.0}), ("mu_s_zero", {"mu_s": 0.0}),
-                 ("reset", {"reset": "half"}), ("damping", {"damping": 1.5})]:
+                 ("reset", {"reset": "half"}), ("damping", {"damping": 1.5}),
+                 ("slip_timing", {"slip_timing": "late"})]:
     try:
         stickslip_engines(**dict(ok, **kw)); out[name] = None
     except ValueError as e:
@@ -110,7 +111,7 @@ def test_bad_parameters_raise_naming_parameter_and_range(tmp_path):
     expect = {"mu_k_high": ["mu_k = 0.6", "[0.25, 0.5]"], "mu_k_low": ["mu_k = 0.2", "[0.25, 0.5]"],
               "ks_zero": ["ks = 0", "> 0"], "ks_neg": ["ks = -1", "> 0"], "nu_s_neg": ["nu_s = -1", ">= 0"],
               "mu_s_zero": ["mu_s = 0", "> 0"], "reset": ["reset", "spring, total"],
-              "damping": ["damping = 1.5", "[0, 1)"], "kn_zero": ["kn = 0", "> 0"], "kn_neg": ["kn = -1", "> 0"],
+              "damping": ["damping = 1.5", "[0, 1)"], "slip_timing": ["slip_timing = 'late'", "step, exact"], "kn_zero": ["kn = 0", "> 0"], "kn_neg": ["kn = -1", "> 0"],
               "nu_n_neg": ["nu_n = -1", ">= 0"]}
     for name, words in expect.items():
         assert r[name] is not None, f"{name} was accepted"

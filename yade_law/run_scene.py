@@ -66,7 +66,7 @@ def build(sc):
                                  rotateAroundZero=True, zeroPoint=Vector3(*r["pivot"]))
             rotators.append((eng, ids[w["name"]], r["steps"]))
     O.engines = stickslip_engines(ks=c["ks"], nu_s=c["nu_s"] if eff["tangential_damping"] else 0.0,
-                                  mu_s=c["mu_s"], mu_k=c["mu_k"], reset=c["reset"],
+                                  mu_s=c["mu_s"], mu_k=c["mu_k"], reset=c["reset"], slip_timing=c["slip_timing"],
                                   gravity=sc["gravity"] if eff["gravity"] else (0.0, 0.0, 0.0),
                                   rotation=eff["rotation"], extra=[e for e, _, _ in rotators])
     O.dt = sc["dt"]

@@ -11,7 +11,10 @@ Use in an ordinary YADE script (full example: yade_law/example_drag.py, README.m
 The native Law2_ScGeom_ViscElPhys_Basic applies the normal force (eq. 3, never
 tensile; kn = Kn, cn = nu_n, no native shear force). A PyRunner placed before
 NewtonIntegrator adds the tangential force of docs/law.md (3D form: the spring
-elongation D is kept in the current tangent plane).
+elongation D is kept in the current tangent plane). The law's arithmetic is the
+repository's numpy kernel pyref/laws.py (turn of the history, eqs. 5, 7, 8, the exact
+slip timing, the energy split), imported from here; this file gathers the kinematics
+from YADE and hands the forces back. With O.trackEnergy the energies go to O.energy.
 
 Why it is written this way (measured on YADE 2023.02a, see README.md):
 - YADE never calls a Python subclass of a Law2 class, and interactions take no extra
@@ -37,40 +40,63 @@ from __future__ import annotations
 import builtins
 import gc
 import math
+import numbers
+import os
+import sys
 from itertools import chain
 
 import numpy as np
 
-RESETS = ("spring", "total")
+# The law's arithmetic lives once, in the repository's numpy kernel pyref/laws.py (it
+# imports numpy only), so that this file needs no copy of it: put the repository on the
+# path and check that the kernel found is this repository's own.
+_REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+if _REPO not in sys.path:
+    sys.path.append(_REPO)
+from pyref import laws as _laws  # noqa: E402
+
+if os.path.realpath(os.path.dirname(os.path.dirname(_laws.__file__))) != os.path.realpath(_REPO):
+    raise ImportError(f"stickslip_yade.py needs the law kernel of its own repository ({_REPO}/pyref/laws.py), "
+                      f"but `pyref` was already imported from {os.path.dirname(_laws.__file__)}")
+LawParams, rotate_history, tangential_force = _laws.LawParams, _laws.rotate_history, _laws.tangential_force
+RESETS, SLIP_TIMINGS = _laws.RESETS, _laws.SLIP_TIMINGS
 
 
-def check_parameters(ks, nu_s, mu_s, mu_k, reset="spring", kn=None, nu_n=None):
-    """Raise ValueError naming the parameter and its allowed range (docs/law.md)."""
-    def finite(name, v):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise ValueError(f"{name} = {v!r}: must be a finite number")
+def _number(name, v):
+    """A finite real number (Python or numpy scalar, not bool) as float, else ValueError."""
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+        raise ValueError(f"{name} = {v!r}: must be a finite number")
+    return float(v)
 
-    for name, v in (("ks", ks), ("nu_s", nu_s), ("mu_s", mu_s), ("mu_k", mu_k)):
-        finite(name, v)
-    if kn is not None:
-        finite("kn", kn)
-        if kn <= 0:
-            raise ValueError(f"kn = {kn:g}: must be > 0")
-    if nu_n is not None:
-        finite("nu_n", nu_n)
-        if nu_n < 0:
-            raise ValueError(f"nu_n = {nu_n:g}: must be >= 0")
-    if ks <= 0:
-        raise ValueError(f"ks = {ks:g}: must be > 0")
-    if nu_s < 0:
-        raise ValueError(f"nu_s = {nu_s:g}: must be >= 0")
-    if mu_s <= 0:
-        raise ValueError(f"mu_s = {mu_s:g}: must be > 0")
-    if not mu_s / 2 <= mu_k <= mu_s:
-        raise ValueError(f"mu_k = {mu_k:g}: must be in [mu_s/2, mu_s] = [{mu_s / 2:g}, {mu_s:g}] "
-                         f"so that 0 <= Fmin = (2 mu_k - mu_s) Fn <= mu_k Fn")
-    if reset not in RESETS:
-        raise ValueError(f"reset = {reset!r}: must be one of {', '.join(RESETS)}")
+
+def check_parameters(ks=None, nu_s=None, mu_s=None, mu_k=None, reset=None, slip_timing=None, kn=None,
+                     nu_n=None):
+    """The law's parameter rules (docs/law.md), for the parameters given (None = not given).
+    Raises ValueError naming the parameter and its allowed range; returns the given values
+    as a dict of floats and strings (numpy scalars become floats)."""
+    out = {}
+    for name, v, low, strict in (("kn", kn, 0.0, True), ("nu_n", nu_n, 0.0, False), ("ks", ks, 0.0, True),
+                                 ("nu_s", nu_s, 0.0, False), ("mu_s", mu_s, 0.0, True)):
+        if v is None:
+            continue
+        v = out[name] = _number(name, v)
+        if v < low or (strict and v == low):
+            raise ValueError(f"{name} = {v:g}: must be {'>' if strict else '>='} {low:g}")
+    if mu_k is not None:
+        v = out["mu_k"] = _number("mu_k", mu_k)
+        if mu_s is None:
+            raise ValueError("mu_k needs mu_s: the allowed range is [mu_s/2, mu_s]")
+        mu_s = out["mu_s"]
+        if not mu_s / 2 <= v <= mu_s:
+            raise ValueError(f"mu_k = {v:g}: must be in [mu_s/2, mu_s] = [{mu_s / 2:g}, {mu_s:g}] "
+                             f"so that 0 <= Fmin = (2 mu_k - mu_s) Fn <= mu_k Fn")
+    for name, v, allowed in (("reset", reset, RESETS), ("slip_timing", slip_timing, SLIP_TIMINGS)):
+        if v is None:
+            continue
+        if not isinstance(v, str) or v not in allowed:
+            raise ValueError(f"{name} = {v!r}: must be one of {', '.join(allowed)}")
+        out[name] = v
+    return out
 
 
 def stickslip_material(kn, nu_n=0.0, density=2600.0, label=None):
@@ -78,10 +104,13 @@ def stickslip_material(kn, nu_n=0.0, density=2600.0, label=None):
     in series, so each side carries twice the value) and no native shear force."""
     from yade import ViscElMat
 
-    check_parameters(1.0, 0.0, 1.0, 1.0, kn=kn, nu_n=nu_n)
+    p = check_parameters(kn=kn, nu_n=nu_n)
+    density = _number("density", density)
     if not density > 0:
-        raise ValueError(f"density = {density!r}: must be > 0")
-    mat = ViscElMat(kn=2.0 * kn, cn=2.0 * nu_n, ks=0.0, cs=0.0, frictionAngle=0.0, density=density)
+        raise ValueError(f"density = {density:g}: must be > 0")
+    if label is not None and not isinstance(label, str):
+        raise ValueError(f"label = {label!r}: must be a string")
+    mat = ViscElMat(kn=2.0 * p["kn"], cn=2.0 * p["nu_n"], ks=0.0, cs=0.0, frictionAngle=0.0, density=density)
     if label:
         mat.label = label
     return mat
@@ -105,13 +134,22 @@ class StickSlipLaw:
     this step, slip steps since the contact was made) or None if not touching.
     """
 
-    def __init__(self, ks, nu_s, mu_s, mu_k, reset="spring", rotation=True, check=False):
-        check_parameters(ks, nu_s, mu_s, mu_k, reset)
-        self.ks, self.nu_s, self.mu_s, self.mu_k, self.reset = ks, nu_s, mu_s, mu_k, reset
-        self.rotation = rotation  # torques (and grain spin in V_s) only when rotation is simulated
-        self.check = check  # compare recomputed normals / normal forces with YADE's (tests, bench)
+    def __init__(self, ks, nu_s, mu_s, mu_k, reset="spring", slip_timing="step", rotation=True, check=False):
+        p = check_parameters(ks=ks, nu_s=nu_s, mu_s=mu_s, mu_k=mu_k, reset=reset, slip_timing=slip_timing)
+        for name, v in (("rotation", rotation), ("check", check)):
+            if not isinstance(v, (bool, np.bool_)):
+                raise ValueError(f"{name} = {v!r}: must be True or False")
+        self.ks, self.nu_s, self.mu_s, self.mu_k = p["ks"], p["nu_s"], p["mu_s"], p["mu_k"]
+        self.reset, self.slip_timing = reset, slip_timing
+        # The kernel's parameters; kn and nu_n are unused there (YADE's own law gives Fn).
+        self.params = LawParams("stick_slip", 0.0, 0.0, self.ks, self.nu_s, self.mu_s, self.mu_k, reset, slip_timing)
+        self.rotation = bool(rotation)  # torques (and grain spin in V_s) only when rotation is simulated
+        self.check = bool(check)  # compare recomputed normals / normal forces with YADE's (tests, bench)
         self.max_fn_error = 0.0  # largest |Fn - native Fn| / max(native Fn) seen with check=True
         self.checked = 0  # sphere-sphere contact-steps compared with check=True
+        # Energy (O.trackEnergy): the least energy one contact took out in one step (docs/law.md,
+        # "Energy": never below round-off in the step mode).
+        self.min_dissipation = 0.0
         self.nbodies = -1
         self._clear()
 
@@ -173,6 +211,8 @@ class StickSlipLaw:
         m = len(L)
         if m == 0:
             self._clear()
+            if O.trackEnergy:
+                self._book(O, 0.0, 0.0, 0.0, 0.0, 0.0)
             return
         i1 = np.fromiter([I.id1 for I in L], np.int64, m)
         i2 = np.fromiter([I.id2 for I in L], np.int64, m)
@@ -191,7 +231,7 @@ class StickSlipLaw:
             D[old], kn[old], cn[old], count[old] = self.D[po], self.kn[po], self.cn[po], self.count[po]
 
         ss = self.sphere[i1] & self.sphere[i2]  # sphere-sphere: geometry recomputed here
-        for k in np.flatnonzero(~old & ss).tolist():  # new contacts: their own kn, cn once
+        for k in np.flatnonzero(~old).tolist():  # new contacts: their own kn, cn once
             ph = L[k].phys
             kn[k], cn[k] = ph.kn, ph.cn
 
@@ -223,6 +263,8 @@ class StickSlipLaw:
             n[other] = _rows([x.normal for x in g])
             c = _rows([x.contactPoint for x in g])
             fn[other] = [L[k].phys.normalForce.norm() for k in other.tolist()]
+            if O.trackEnergy:  # the normal spring's energy needs YADE's overlap
+                delta[other] = [x.penetrationDepth for x in g]
             s1, s2 = self.sphere[i1[other]], self.sphere[i2[other]]
             a1[other] = np.where(s1[:, None], r1[other, None] * n[other], c - x1[other])
             a2[other] = np.where(s2[:, None], -r2[other, None] * n[other], c - x2[other])
@@ -235,28 +277,15 @@ class StickSlipLaw:
             v_rel = v_rel + np.cross(W[i1], a1) - np.cross(W[i2], a2)
         V_s = v_rel - _dot(v_rel, n)[:, None] * n
 
-        # The spring, turned into the current tangent plane keeping its length, then
-        # loaded by this step's tangential displacement (eq. 7).
-        dn = _dot(D, n)
-        if dn.any():
-            old_len = _dot(D, D)
-            D = D - dn[:, None] * n
-            new_len = _dot(D, D)
-            D *= np.where(new_len > 0, np.sqrt(old_len / np.where(new_len > 0, new_len, 1.0)), 1.0)[:, None]
-        D = D + V_s * dt
-        F_t = -self.ks * D - self.nu_s * V_s  # trial force on id1 (eq. 5)
-        mag = np.sqrt(_dot(F_t, F_t))
-        slip = mag >= self.mu_s * fn  # Coulomb's static threshold (Fn = 0 always slips)
-        F_s = F_t
-        if slip.any():  # kinetic phase: Fmin = (2 mu_k - mu_s) Fn along the trial force
-            f_min = (2.0 * self.mu_k - self.mu_s) * fn
-            F_s = F_t * np.where(slip, f_min / np.where(mag > 0, mag, 1.0), 1.0)[:, None]
-            if self.reset == "spring":
-                D_slip = -F_s / self.ks  # eq. 8: Ks |D| = Fmin
-            else:  # "total": spring + dashpot = Fmin (keeps a saw-tooth when nu_s |V_s| is large)
-                D_slip = -(F_s + self.nu_s * V_s) / self.ks
-            D = np.where(slip[:, None], D_slip, D)
-            count = count + slip
+        # The spring turned into the current tangent plane keeping its length, loaded by
+        # this step's tangential displacement (eq. 7), the trial force (eq. 5), the slip and
+        # the reset (eq. 8): all in the kernel, pyref/laws.py.
+        energy = O.trackEnergy
+        tan = tangential_force(rotate_history(D, n), V_s, fn, dt, self.params, energy=energy)
+        F_s, D, slip = tan.force, tan.spring, tan.slipped
+        count = count + slip
+        if energy:
+            self._energy(O, tan, D, kn, delta, fn, _dot(v_rel, n), dt)
 
         # Forces and torques summed per body, one addF/addT per body that gets any.
         self._add(O.forces.addF, i1, i2, F_s, -F_s, nb)
@@ -267,6 +296,30 @@ class StickSlipLaw:
         self.keys, self.made, self.D = key[order], made[order], D[order]
         self.kn, self.cn, self.fn, self.F_s = kn[order], cn[order], fn[order], F_s[order]
         self.slipped, self.count = slip[order], count[order]
+
+    def _energy(self, O, tan, D, kn, delta, fn, v_n, dt):
+        """Book this step's energies in O.energy (with O.trackEnergy; YADE's keys `kinetic`
+        and `gravWork` come from NewtonIntegrator): the tangential law's dissipation split
+        into slips and dashpot (docs/law.md, Energy) and its spring energy Ks|D|^2/2, and,
+        because Law2_ScGeom_ViscElPhys_Basic books nothing, the normal law's elastic energy
+        Kn*delta^2/2 and what its dashpot took, (Fn - Kn*delta)*v_n*dt (Fn clipped at 0
+        included). Cumulative entries are read back from O.energy each step, so they live
+        in the scene and follow its checkpoints."""
+        e_t = tan.dissipated_dashpot + tan.dissipated_slip
+        if len(e_t):
+            self.min_dissipation = min(self.min_dissipation, float(e_t.min()))
+        self._book(O, tan.dissipated_slip.sum(), tan.dissipated_dashpot.sum(), ((fn - kn * delta) * v_n).sum() * dt,
+                   0.5 * self.ks * _dot(D, D).sum(), 0.5 * (kn * delta * delta).sum())
+
+    @staticmethod
+    def _book(O, slip, dashpot, normal_damping, spring, normal_elastic):
+        E = O.energy
+        have = set(E.keys())
+        for name, inc in (("stickslip_slip", slip), ("stickslip_dashpot", dashpot),
+                          ("stickslip_normal_damping", normal_damping)):
+            E[name] = (E[name] if name in have else 0.0) + float(inc)
+        E["stickslip_spring"] = float(spring)
+        E["stickslip_normal_elastic"] = float(normal_elastic)
 
     @staticmethod
     def _add(add, i1, i2, f1, f2, nb):
@@ -314,8 +367,8 @@ class StickSlipLaw:
         return len(self.keys)
 
 
-def stickslip_engines(ks, nu_s, mu_s, mu_k, reset="spring", gravity=(0.0, 0.0, 0.0), damping=0.0,
-                      rotation=True, extra=(), check=False):
+def stickslip_engines(ks, nu_s, mu_s, mu_k, reset="spring", slip_timing="step", gravity=(0.0, 0.0, 0.0),
+                      damping=0.0, rotation=True, extra=(), check=False):
     """The engine list for O.engines: collision detection, native normal law, this law,
     `extra` engines (e.g. a RotationEngine), then Newton's integration. The law object is
     published as `builtins.stickslip_law` (a PyRunner's command runs in __main__)."""
@@ -326,7 +379,7 @@ def stickslip_engines(ks, nu_s, mu_s, mu_k, reset="spring", gravity=(0.0, 0.0, 0
 
     if isinstance(damping, bool) or not isinstance(damping, (int, float)) or not 0 <= damping < 1:
         raise ValueError(f"damping = {damping!r}: must be in [0, 1)")
-    law = StickSlipLaw(ks, nu_s, mu_s, mu_k, reset, rotation=rotation, check=check)
+    law = StickSlipLaw(ks, nu_s, mu_s, mu_k, reset, slip_timing, rotation=rotation, check=check)
     builtins.stickslip_law = law
     return [
         ForceResetter(),
