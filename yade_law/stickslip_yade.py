@@ -37,12 +37,15 @@ bodies appended during a run are picked up, an erased body's id reused is not.
 """
 from __future__ import annotations
 
+import base64
 import builtins
 import gc
+import json
 import math
 import numbers
 import os
 import sys
+import uuid
 from itertools import chain
 
 import numpy as np
@@ -116,6 +119,9 @@ def stickslip_material(kn, nu_n=0.0, density=2600.0, label=None):
     return mat
 
 
+_LAWS = {}  # token -> StickSlipLaw, the laws of this process
+
+
 def _dot(a, b):
     return np.einsum("ij,ij->i", a, b)
 
@@ -151,7 +157,55 @@ class StickSlipLaw:
         # "Energy": never below round-off in the step mode).
         self.min_dissipation = 0.0
         self.nbodies = -1
+        # Checkpoints: the scene the state below belongs to, the iteration of the law's last
+        # step there (-1: none), and the token naming this law in its runner's command.
+        self.token = uuid.uuid4().hex[:16]
+        self._scene, self.last_iter = None, -1
+        _LAWS[self.token] = self
         self._clear()
+
+    # State carried from step to step and saved with the scene (arrays share one row per contact).
+    ARRAYS = ("keys", "made", "D", "kn", "cn", "fn", "F_s", "slipped", "count")
+    SCALARS = ("last_iter", "min_dissipation", "max_fn_error", "checked")
+
+    def params_dict(self):
+        return {"ks": self.ks, "nu_s": self.nu_s, "mu_s": self.mu_s, "mu_k": self.mu_k, "reset": self.reset,
+                "slip_timing": self.slip_timing, "rotation": self.rotation, "check": self.check}
+
+    def _saved_state(self, O, fresh=False):
+        """The law's state as a string for O.tags (YADE saves the tags with the scene)."""
+        arrays = {} if fresh else {k: getattr(self, k) for k in self.ARRAYS}
+        return json.dumps({
+            "version": 1, "token": self.token, "params": self.params_dict(), "iter": O.iter,
+            "scalars": {"last_iter": -1} if fresh else {k: getattr(self, k) for k in self.SCALARS},
+            "arrays": {k: [a.dtype.str, a.shape, base64.b64encode(np.ascontiguousarray(a).tobytes()).decode()]
+                       for k, a in arrays.items()}})
+
+    def _adopt(self, O, scene):
+        """The scene is not the one the state belongs to: first step, or the scene was
+        replaced (O.load, O.loadTmp, O.reload, O.reset). Take the state saved with the scene
+        if it was saved at this very iteration; otherwise start afresh only where nothing is
+        lost, else refuse (a silent restart of every spring would be a wrong answer)."""
+        saved = O.tags["stickslip_law"] if "stickslip_law" in O.tags.keys() else None
+        st = json.loads(saved) if saved else None
+        ran = self._scene is not None and self.last_iter >= 0
+        if st is not None and st["iter"] == O.iter:
+            self._clear()
+            for k, (dtype, shape, data) in st["arrays"].items():
+                setattr(self, k, np.frombuffer(base64.b64decode(data), dtype=dtype).reshape(shape).copy())
+            for k, v in st["scalars"].items():
+                setattr(self, k, v)
+        elif ran and O.iter > 0:
+            why = (f"its stick-slip state was saved at iteration {st['iter']}" if st else
+                   "it carries no stick-slip state (O.tags['stickslip_law'])")
+            raise RuntimeError(f"stick-slip law: the scene was replaced (O.load/loadTmp/reload?) and is at iteration "
+                               f"{O.iter}, but {why}: it was saved by a path that bypasses stickslip_yade's save hook "
+                               f"(O.save, O.saveTmp, O.sceneToString are hooked); the springs cannot be restored")
+        else:  # a new law, or a new scene from iteration 0: nothing to continue
+            self._clear()
+            self.last_iter = -1
+        self._scene = scene
+        self.nbodies = -1  # body data (State objects, radii) is the new scene's
 
     def _clear(self):
         z = np.zeros(0)
@@ -205,6 +259,10 @@ class StickSlipLaw:
     def _step(self):
         from yade import O
 
+        scene = O._sceneObj
+        if self._scene is None or not scene == self._scene:  # Serializable ==: the same C++ object
+            self._adopt(O, scene)
+        self.last_iter = O.iter
         if len(O.bodies) != self.nbodies:
             self._refresh_bodies(O)
         L = list(O.interactions)  # real (touching) interactions only
@@ -367,6 +425,80 @@ class StickSlipLaw:
         return len(self.keys)
 
 
+def step(token):
+    """What the law's PyRunner runs each step. In a process that did not build the law
+    (a scene loaded by O.load in a new process) the law is rebuilt from the parameters
+    saved with the scene and published as `builtins.stickslip_law`."""
+    law = _LAWS.get(token)
+    if law is None:
+        law = _law_from_scene(token)
+    law.step()
+
+
+def _law_from_scene(token):
+    from yade import O
+
+    if "stickslip_law" not in O.tags.keys():
+        raise RuntimeError(f"stick-slip law: this scene's runner names law {token}, which this process has not "
+                           f"built, and the scene carries no saved law (O.tags['stickslip_law']): it was saved by a "
+                           f"path that bypasses stickslip_yade's save hook; the springs cannot be restored")
+    st = json.loads(O.tags["stickslip_law"])
+    law = StickSlipLaw(**st["params"])
+    del _LAWS[law.token]
+    law.token = token  # the name the saved runner uses
+    _LAWS[token] = law
+    builtins.stickslip_law = law
+    return law
+
+
+def _runner_command(token):
+    """One expression, compiled by PyRunner every step (so kept short): this module, imported
+    from its own folder if the process has not imported it yet (O.load in a new process),
+    runs the law named by `token`."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    return (f"(__import__('sys').modules.get('stickslip_yade') or (__import__('sys').path.append({here!r}), "
+            f"__import__('stickslip_yade'))[1]).step({token!r})")
+
+
+def _store_state():
+    """Before YADE serialises the scene: put the state of the law that runs in it into
+    O.tags, with the iteration, so that any load can check it belongs to the scene."""
+    from yade import O, PyRunner
+
+    for e in O.engines:
+        if isinstance(e, PyRunner) and "stickslip_yade" in e.command and ".step('" in e.command:
+            law = _LAWS.get(e.command.rsplit(".step('", 1)[1].split("'")[0])
+            if law is None:  # a loaded scene whose law has not run here: its saved state still holds
+                continue
+            fresh = law._scene is None or not O._sceneObj == law._scene
+            O.tags["stickslip_law"] = law._saved_state(O, fresh=fresh)
+
+
+def _install_save_hooks():
+    """YADE's own savers (O.save, O.saveTmp, O.sceneToString) store the law's state first."""
+    import yade.wrapper
+
+    Omega = yade.wrapper.Omega
+    if getattr(Omega, "_stickslip_hooked", False):
+        return
+    for name in ("save", "saveTmp", "sceneToString"):
+        original = getattr(Omega, name)
+
+        def hooked(self, *args, _original=original, **kw):
+            _store_state()
+            return _original(self, *args, **kw)
+
+        hooked.__doc__ = original.__doc__
+        setattr(Omega, name, hooked)
+    Omega._stickslip_hooked = True
+
+
+try:  # outside YADE (tests of check_parameters) there is nothing to hook
+    _install_save_hooks()
+except ImportError:
+    pass
+
+
 def stickslip_engines(ks, nu_s, mu_s, mu_k, reset="spring", slip_timing="step", gravity=(0.0, 0.0, 0.0),
                       damping=0.0, rotation=True, extra=(), check=False):
     """The engine list for O.engines: collision detection, native normal law, this law,
@@ -387,7 +519,8 @@ def stickslip_engines(ks, nu_s, mu_s, mu_k, reset="spring", slip_timing="step", 
         InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
                         [Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),
         # initRun=True: otherwise the first step runs without the tangential force.
-        PyRunner(command="stickslip_law.step()", iterPeriod=1, initRun=True, label="stickslip_runner"),
+        PyRunner(command=_runner_command(law.token), iterPeriod=1, initRun=True, updateGlobals=False,
+                 label="stickslip_runner"),
         *extra,
         NewtonIntegrator(gravity=tuple(gravity), damping=damping),
     ]
