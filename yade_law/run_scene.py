@@ -136,6 +136,9 @@ def main(scene_path, out_path):
             O.bodies[bid].state.angVel = Vector3(0, 0, 0)
         if step % every == 0:
             rows.append(row(step))
+            bad = [h for h, v in zip(header, rows[-1]) if not math.isfinite(v)]
+            if bad:
+                raise RuntimeError(f"non-finite {', '.join(bad[:4])} at step {step} (t = {step * O.dt:g} s)")
         if step % 5000 == 0:
             print(f"PROGRESS {step} {steps}", flush=True)
     wall = time.perf_counter() - t0
@@ -146,10 +149,35 @@ def main(scene_path, out_path):
     print(f"WALLTIME {wall}", flush=True)
 
 
+def law_error(e):
+    """The law's own one-line message for an error raised inside its PyRunner (YADE wraps
+    it into "PyRunner error. COMMAND: ... ERROR: <message> ... STACK TRACE ...")."""
+    import builtins
+
+    law = getattr(builtins, "stickslip_law", None)
+    if law is not None and law.error:
+        return law.error
+    text = str(e)
+    if "ERROR:" in text:
+        text = text.split("ERROR:", 1)[1].strip()
+    return text.splitlines()[0] if text else type(e).__name__
+
+
 if __name__ == "__main__":
+    # One line on stdout for the adapter (and the user), the traceback only in the log.
+    import traceback
+
     try:
         main(sys.argv[1], sys.argv[2])
-    except ValueError as e:  # a bad parameter: one line, no traceback
+    except ValueError as e:  # a bad parameter
         print(f"ERROR {e}", flush=True)
         sys.exit(3)
+    except RuntimeError as e:  # the run failed (the law refused a scene, or values went non-finite)
+        traceback.print_exc(file=sys.stderr)
+        print(f"ERROR {law_error(e)}", flush=True)
+        sys.exit(4)
+    except Exception as e:  # noqa: BLE001 -- anything else, still one line
+        traceback.print_exc(file=sys.stderr)
+        print(f"ERROR run_scene.py: {type(e).__name__}: {e}", flush=True)
+        sys.exit(5)
     sys.exit(0)

@@ -102,6 +102,27 @@ def check_parameters(ks=None, nu_s=None, mu_s=None, mu_k=None, reset=None, slip_
     return out
 
 
+def _flag(name, v):
+    if not isinstance(v, (bool, np.bool_)):
+        raise ValueError(f"{name} = {v!r}: must be True or False")
+    return bool(v)
+
+
+def _vector3(name, v):
+    """Three finite numbers (a tuple, list, numpy array or Vector3) as a tuple of floats."""
+    try:
+        items = None if isinstance(v, (str, bytes)) else [v[0], v[1], v[2]]
+        ok = items is not None and len(v) == 3
+    except (TypeError, IndexError, KeyError):
+        ok = False
+    if ok:
+        try:
+            return tuple(_number(name, x) for x in items)
+        except ValueError:
+            pass
+    raise ValueError(f"{name} = {v!r}: must be 3 finite numbers")
+
+
 def stickslip_material(kn, nu_n=0.0, density=2600.0, label=None):
     """A ViscElMat whose contacts get kn = Kn and cn = nu_n (Ip2 puts the two materials
     in series, so each side carries twice the value) and no native shear force."""
@@ -156,6 +177,7 @@ class StickSlipLaw:
         # Energy (O.trackEnergy): the least energy one contact took out in one step (docs/law.md,
         # "Energy": never below round-off in the step mode).
         self.min_dissipation = 0.0
+        self.error = None  # the message of the error that stopped the run, if any
         self.nbodies = -1
         # Checkpoints: the scene the state below belongs to, the iteration of the law's last
         # step there (-1: none), and the token naming this law in its runner's command.
@@ -305,10 +327,16 @@ class StickSlipLaw:
         if len(spin):
             W[spin] = _rows([st[i].angVel for i in spin.tolist()])
 
+        self._finite_bodies(O, used, P, V, W)
         x1, x2 = P[i1], P[i2]
         r1, r2 = self.radius[i1], self.radius[i2]
         d = x2 - x1
         dist = np.sqrt(_dot(d, d))
+        same = ss & (dist == 0)
+        if same.any():
+            k = int(np.flatnonzero(same)[0])
+            self._fail(f"contact ({i1[k]}, {i2[k]}) at iteration {O.iter}: the two spheres have the same centre, "
+                       f"so the contact has no normal direction")
         n = d / np.where(dist > 0, dist, 1.0)[:, None]  # unit normal from id1 to id2
         delta = r1 + r2 - dist
         v_rel0 = V[i1] - V[i2]
@@ -341,6 +369,11 @@ class StickSlipLaw:
         energy = O.trackEnergy
         tan = tangential_force(rotate_history(D, n), V_s, fn, dt, self.params, energy=energy)
         F_s, D, slip = tan.force, tan.spring, tan.slipped
+        bad = ~(np.isfinite(fn) & np.isfinite(F_s).all(axis=1))
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            self._fail(f"non-finite force on contact ({i1[k]}, {i2[k]}) at iteration {O.iter} (Fn = {fn[k]!r}, "
+                       f"F_s = {F_s[k].tolist()}): bodies at the same place, or a blown-up run")
         count = count + slip
         if energy:
             self._energy(O, tan, D, kn, delta, fn, _dot(v_rel, n), dt)
@@ -354,6 +387,20 @@ class StickSlipLaw:
         self.keys, self.made, self.D = key[order], made[order], D[order]
         self.kn, self.cn, self.fn, self.F_s = kn[order], cn[order], fn[order], F_s[order]
         self.slipped, self.count = slip[order], count[order]
+
+    def _fail(self, message):
+        """Stop the run with one clear line (kept in `self.error`: YADE wraps the exception
+        of a PyRunner into its own RuntimeError text)."""
+        self.error = f"stick-slip law: {message}"
+        raise RuntimeError(self.error)
+
+    def _finite_bodies(self, O, used, P, V, W):
+        for what, X in (("position", P), ("velocity", V), ("angular velocity", W)):
+            ok = np.isfinite(X[used]).all(axis=1)
+            if not ok.all():
+                i = int(used[np.flatnonzero(~ok)[0]])
+                self._fail(f"body {i} has a non-finite {what} {X[i].tolist()} at iteration {O.iter}: the run has "
+                           f"blown up (time step above the stability limit?) or was given a non-finite value")
 
     def _energy(self, O, tan, D, kn, delta, fn, v_n, dt):
         """Book this step's energies in O.energy (with O.trackEnergy; YADE's keys `kinetic`
@@ -509,8 +556,11 @@ def stickslip_engines(ks, nu_s, mu_s, mu_k, reset="spring", slip_timing="step", 
                       Ip2_ViscElMat_ViscElMat_ViscElPhys, Law2_ScGeom_ViscElPhys_Basic, NewtonIntegrator,
                       PyRunner)
 
-    if isinstance(damping, bool) or not isinstance(damping, (int, float)) or not 0 <= damping < 1:
+    gravity = _vector3("gravity", gravity)
+    damping = _number("damping", damping)
+    if not 0 <= damping < 1:
         raise ValueError(f"damping = {damping!r}: must be in [0, 1)")
+    extra = _extra_engines(extra)
     law = StickSlipLaw(ks, nu_s, mu_s, mu_k, reset, slip_timing, rotation=rotation, check=check)
     builtins.stickslip_law = law
     return [
@@ -522,5 +572,21 @@ def stickslip_engines(ks, nu_s, mu_s, mu_k, reset="spring", slip_timing="step", 
         PyRunner(command=_runner_command(law.token), iterPeriod=1, initRun=True, updateGlobals=False,
                  label="stickslip_runner"),
         *extra,
-        NewtonIntegrator(gravity=tuple(gravity), damping=damping),
+        NewtonIntegrator(gravity=gravity, damping=damping),
     ]
+
+
+def _extra_engines(extra):
+    """`extra`: YADE engines to run between the law and NewtonIntegrator (not a second copy
+    of what the list already has)."""
+    from yade.wrapper import Collider, Engine, ForceResetter, InteractionLoop, NewtonIntegrator
+
+    if isinstance(extra, (str, bytes)) or not hasattr(extra, "__iter__"):
+        raise ValueError(f"extra = {extra!r}: must be a list of YADE engines")
+    extra = list(extra)
+    for k, e in enumerate(extra):
+        if not isinstance(e, Engine):
+            raise ValueError(f"extra[{k}] = {e!r}: must be a YADE engine (e.g. RotationEngine(...))")
+        if isinstance(e, (Collider, ForceResetter, InteractionLoop, NewtonIntegrator)):
+            raise ValueError(f"extra[{k}] = {type(e).__name__}: stickslip_engines already has one")
+    return extra
