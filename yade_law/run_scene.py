@@ -98,16 +98,18 @@ def main(scene_path, out_path):
     if out["stats"]:
         header += ["n_contacts", "ekin"]
     slips = [0] * len(pairs)
+    last = [law.lookup(*key) for key, _ in pairs]  # each pair's (Fn, F_s, slipped) after the last step
 
     def row(step):
         r = [step * O.dt]
         for g in out["grains"]:
             s = O.bodies[ids[g]].state
-            r += [s.pos[k] for k in range(dim)] + [s.vel[k] for k in range(dim)]
+            r += list(s.pos.__getinitargs__()[:dim] + s.vel.__getinitargs__()[:dim])  # one read per vector
             if sc["effects"]["rotation"]:
-                r += [s.angVel[2]] if dim == 2 else [s.angVel[k] for k in range(3)]
+                w = s.angVel.__getinitargs__()
+                r += [w[2]] if dim == 2 else list(w)
         for k, (key, sign) in enumerate(pairs):
-            fn, f, _ = law.lookup(*key) or (0.0, (0.0, 0.0, 0.0), False)
+            fn, f, _ = last[k] or (0.0, (0.0, 0.0, 0.0), False)
             ft = [sign * f[q] for q in range(3)]
             r += [fn, math.sqrt(sum(x * x for x in ft))] + ft[:dim] + [slips[k]]
             slips[k] = 0
@@ -124,11 +126,10 @@ def main(scene_path, out_path):
     t0 = time.perf_counter()
     for step in range(1, steps + 1):
         O.step()
-        if pairs:
-            for k, (key, _) in enumerate(pairs):
-                got = law.lookup(*key)
-                if got is not None and got[2]:
-                    slips[k] += 1
+        for k, (key, _) in enumerate(pairs):
+            got = last[k] = law.lookup(*key)
+            if got is not None and got[2]:
+                slips[k] += 1
         if step in stop_at:  # the wall has turned to its stop angle: hold it there
             eng, bid = stop_at[step]
             eng.dead = True
