@@ -244,11 +244,13 @@ class StickSlipLaw:
         self._idx = None  # ids, sphere-pair flags and radii per contact (see _index)
         self._wrappers = {}  # key -> YADE Interaction of contacts with a non-sphere
 
-    def _take(self, rows):
+    def _take(self, rows, keyset_updated=False):
         """Keep the contacts `rows` (an index or boolean array), in that order."""
         for k in self.ARRAYS:
             setattr(self, k, getattr(self, k)[rows])
-        self._keyset = self._sorted = self._idx = None
+        self._sorted = self._idx = None
+        if not keyset_updated:
+            self._keyset = None
 
     def _append(self, new):
         """Append contacts (a dict of per-contact arrays, missing ones start at zero)."""
@@ -529,7 +531,7 @@ class StickSlipLaw:
             g = {k: v[kept] for k, v in g.items()}
             other = remap[other[kept]]
             d, dist, delta = d[alive], dist[alive], delta[alive]
-            self._take(alive)
+            self._take(alive, keyset_updated=True)
             idx = self._index()
         geo = self._assemble(idx, d, dist, delta, other, g)
         if made:
