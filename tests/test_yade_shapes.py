@@ -263,8 +263,8 @@ print("RESULT " + json.dumps({{"n0": _n, "n": len([b for b in O.bodies if b is n
     return head + text + tail
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("example", ["baraban", "clump-inbox", "periodicSandPile"])
+@pytest.mark.parametrize("example", ["baraban", "clump-inbox",  # 7 s, 4 s
+                                     pytest.param("periodicSandPile", marks=pytest.mark.slow)])  # 20 s
 def test_shipped_examples_run_with_the_law(tmp_path, example):
     """Variants of three of Debian's YADE examples: a drum of facets turned by a
     RotationEngine (baraban/baraban.py), clumps and spheres falling into a facet box
