@@ -1,4 +1,5 @@
 """The YADE law against pyref on the paper's cases (issue 4), and its parameter errors."""
+import functools
 import math
 import shutil
 import subprocess
@@ -11,7 +12,7 @@ import pytest
 from stickslip import analysis
 from stickslip import scene as scene_mod
 from stickslip.adapters import yade as yade_adapter
-from conftest import paper_case
+from conftest import paper_case, run_pyref
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "yade_law"))
@@ -26,6 +27,7 @@ needs_yade = pytest.mark.skipif(shutil.which("yade") is None, reason="yade not i
     ({"ks": -1.0}, ["ks = -1", "> 0"]),
     ({"nu_s": -1.0}, ["nu_s = -1", ">= 0"]),
     ({"reset": "half"}, ["reset", "spring, total"]),
+    ({"slip_timing": "late"}, ["slip_timing = 'late'", "step, exact"]),
 ])
 def test_bad_parameters_name_the_parameter_and_range(kw, words):
     args = dict(ks=9.6e6, nu_s=33.1, mu_s=0.5, mu_k=0.45, reset="spring")
@@ -34,6 +36,18 @@ def test_bad_parameters_name_the_parameter_and_range(kw, words):
         check_parameters(**args)
     for w in words:
         assert w in str(e.value)
+
+
+def test_the_yade_law_uses_the_one_numpy_kernel():
+    """The law's arithmetic exists once: stickslip_yade calls pyref/laws.py, no copy."""
+    import pyref.laws
+    import stickslip_yade
+
+    assert stickslip_yade.tangential_force is pyref.laws.tangential_force
+    assert stickslip_yade.rotate_history is pyref.laws.rotate_history
+    src = (ROOT / "yade_law" / "stickslip_yade.py").read_text()
+    for copy_of_kernel in ("f_min / np.maximum(mag", "2.0 * mu_k - mu_s) * fn", "scale = np.sqrt(old /"):
+        assert copy_of_kernel not in src
 
 
 @needs_yade
@@ -53,10 +67,23 @@ def run_yade(name, tmp_path, **kw):
     return sc, res.timeseries
 
 
+def pyref_case(name, slip_timing):
+    """pyref's run of a paper case (shared with the other tests in the step mode)."""
+    if slip_timing == "step":
+        return paper_case(name)[1]
+    return _pyref_exact(name)
+
+
+@functools.lru_cache(maxsize=None)
+def _pyref_exact(name):
+    return run_pyref(scene_mod.load(name, slip_timing="exact"))[0]
+
+
 @needs_yade
-def test_drag_matches_pyref(tmp_path):
-    sc, dy = run_yade("drag", tmp_path)
-    _, dp, _ = paper_case("drag")
+@pytest.mark.parametrize("timing", ["step", "exact"])
+def test_drag_matches_pyref(tmp_path, timing):
+    sc, dy = run_yade("drag", tmp_path, slip_timing=timing)
+    dp = pyref_case("drag", timing)
     sy, sp = analysis.summarise(sc, dy), analysis.summarise(sc, dp)
     for k in ("fs_fn_max", "fs_fn_min", "fs_fn_mean", "slip_period_s"):
         assert sy[k] == pytest.approx(sp[k], rel=0.01), k
@@ -74,17 +101,42 @@ def test_drag_matches_pyref(tmp_path):
     dfn = np.abs(dy[f"{c}_fn"] - dp[f"{c}_fn"]).to_numpy()[1:]
     dfs = np.abs(dy[f"{c}_fs"] - dp[f"{c}_fs"]).to_numpy()[1:]
     assert dfn.max() <= dfn_bound
-    assert dfs.max() <= (2 * sc.contact.mu_k - sc.contact.mu_s) * dfn_bound + 1e-12
-    assert (dy[f"{c}_slip"] == dp[f"{c}_slip"]).all()
+    slip_y, slip_p = dy[f"{c}_slip"].to_numpy() > 0, dp[f"{c}_slip"].to_numpy() > 0
+    if timing == "step":
+        assert (slip_y == slip_p).all()
+    else:
+        # Exact mode: a slip happens when the force, growing by Ks*V per second, reaches
+        # mu_s*Fn, so the engines' Fn difference moves its instant by mu_s*dFn/(Ks*V): a
+        # slip that close to the end of a step may fall at the start of the next one in the
+        # other engine. With the measured dFn that is under one step, so slips pair up
+        # within one row.
+        shift = sc.contact.mu_s * dfn.max() / (sc.contact.ks * 1e-5 * sc.dt)  # in steps (V = 1e-5 m/s)
+        assert shift < 1
+        rows_y, rows_p = np.flatnonzero(slip_y), np.flatnonzero(slip_p)
+        assert len(rows_y) == len(rows_p) and np.abs(rows_y - rows_p).max() <= 1
+    # Where both engines slipped or stuck alike, Fs differs only through Fmin: in the step
+    # mode by (2 mu_k - mu_s)*dFn; in the exact mode a step with a slip ends at
+    # Fmin + kept + rate*(1 - theta) with theta = (mu_s*Fn - F_0)/rate, so by
+    # 2(mu_s - mu_k)*dFn, smaller here.
+    alike = (slip_y == slip_p)[1:]
+    assert dfs[alike].max() <= (2 * sc.contact.mu_k - sc.contact.mu_s) * dfn_bound + 1e-12
 
 
 @needs_yade
-def test_tilt_matches_pyref(tmp_path):
-    sc, dy = run_yade("tilt", tmp_path)
-    _, dp, _ = paper_case("tilt")
+@pytest.mark.parametrize("timing", ["step", "exact"])
+def test_tilt_matches_pyref(tmp_path, timing):
+    sc, dy = run_yade("tilt", tmp_path, slip_timing=timing)
+    dp = pyref_case("tilt", timing)
     sy, sp = analysis.summarise(sc, dy), analysis.summarise(sc, dp)
-    for k in ("tan_beta_first_slip", "accel_stick_slip_mps2", "accel_steady_mps2"):
+    for k in ("tan_beta_first_slip", "accel_steady_mps2"):
         assert sy[k] == pytest.approx(sp[k], rel=0.01), k
+    # The mean acceleration of the stick-slip phase is its speed gain over its duration
+    # (4 ms); the phase starts at the first slip, which the engines place a few steps
+    # apart (below), so it carries their first-slip lag relative to that duration on top
+    # (measured 0.87 % in the step mode, 1.03 % in the exact mode: both 5 steps of 8 us).
+    tol = 0.01 if timing == "step" else 0.01 + abs(sy["t_first_slip_s"] - sp["t_first_slip_s"]) / sp[
+        "stick_slip_duration_s"]
+    assert sy["accel_stick_slip_mps2"] == pytest.approx(sp["accel_stick_slip_mps2"], rel=tol)
     # The speed down the plate after the first slip: the engines start from different
     # half-kicks and their first slips fall a few steps apart (t_first_slip differs by
     # dt-multiples), so compare the histories to the velocity gained in those steps:
@@ -125,13 +177,15 @@ def test_poured_packing_statistics_match_pyref(tmp_path):
     its peak), stay finite, and agree on the settled pile: mean height within 2 % (set by
     the packing fraction, +-1 grain layer of 12 would be 8 %) and the number of contacts
     within 10 % (coordination of a 2D frictional pile varies by a few % between
-    realisations)."""
+    realisations). The pour runs 0.3 s: at 0.15 s the piles are still making contacts
+    (final counts 143-199 over four seeds on one engine, measured, so the 10 % held only
+    by luck), at 0.3 s they have settled (198-211 on pyref and YADE for two seeds)."""
     import tomllib
 
     from test_packing import POUR
     from conftest import run_pyref
 
-    text = POUR.format(nx=12, ny=10, duration=0.15, dt=5e-6, width=0.003 + 12 * 2 * 0.002 * 1.2 * 1.05 + 0.001)
+    text = POUR.format(nx=12, ny=10, duration=0.3, dt=5e-6, width=0.003 + 12 * 2 * 0.002 * 1.2 * 1.05 + 0.001)
     data = tomllib.loads(text)
     sc = scene_mod.parse(data)
     sc.output.grains = [g.name for g in sc.grains]

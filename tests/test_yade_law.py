@@ -89,7 +89,8 @@ ok = dict(ks=9.6e6, nu_s=33.1, mu_s=0.5, mu_k=0.45)
 out = {}
 for name, kw in [("mu_k_high", {"mu_k": 0.6}), ("mu_k_low", {"mu_k": 0.2}), ("ks_zero", {"ks": 0.0}),
                  ("ks_neg", {"ks": -1.0}), ("nu_s_neg", {"nu_s": -1.0}), ("mu_s_zero", {"mu_s": 0.0}),
-                 ("reset", {"reset": "half"}), ("damping", {"damping": 1.5})]:
+                 ("reset", {"reset": "half"}), ("damping", {"damping": 1.5}),
+                 ("slip_timing", {"slip_timing": "late"})]:
     try:
         stickslip_engines(**dict(ok, **kw)); out[name] = None
     except ValueError as e:
@@ -110,7 +111,7 @@ def test_bad_parameters_raise_naming_parameter_and_range(tmp_path):
     expect = {"mu_k_high": ["mu_k = 0.6", "[0.25, 0.5]"], "mu_k_low": ["mu_k = 0.2", "[0.25, 0.5]"],
               "ks_zero": ["ks = 0", "> 0"], "ks_neg": ["ks = -1", "> 0"], "nu_s_neg": ["nu_s = -1", ">= 0"],
               "mu_s_zero": ["mu_s = 0", "> 0"], "reset": ["reset", "spring, total"],
-              "damping": ["damping = 1.5", "[0, 1)"], "kn_zero": ["kn = 0", "> 0"], "kn_neg": ["kn = -1", "> 0"],
+              "damping": ["damping = 1.5", "[0, 1)"], "slip_timing": ["slip_timing = 'late'", "step, exact"], "kn_zero": ["kn = 0", "> 0"], "kn_neg": ["kn = -1", "> 0"],
               "nu_n_neg": ["nu_n = -1", ">= 0"]}
     for name, words in expect.items():
         assert r[name] is not None, f"{name} was accepted"
@@ -182,12 +183,16 @@ for x, ax in ((0.0, 0), (0.022, 0), (0.0, 1), (0.022, 1)):
     O.bodies.append(utils.wall(x, axis=ax, material=mat))
 O.engines = stickslip_engines(ks=8e3, nu_s=0.2, mu_s=0.5, mu_k=0.4, gravity=(0, 0, -9.81), check=True)
 O.dt = 1e-5
-most = 0
+most, changes, last = 0, 0, set()
 for _ in range(6000):
     O.step()
     most = max(most, stickslip_law.n_contacts())
+    now = set(stickslip_law.keys.tolist())
+    changes += len(now ^ last)
+    last = now
 print("RESULT " + json.dumps({"most": most, "fn_error": stickslip_law.max_fn_error,
-      "slips": int(stickslip_law.count.sum()), "checked": stickslip_law.checked}))
+      "slips": int(stickslip_law.count.sum()), "checked": stickslip_law.checked, "changes": changes,
+      "full_reads": stickslip_law.full_reads, "set_checks": stickslip_law.set_checks}))
 """
 
 
@@ -199,6 +204,9 @@ def test_recomputed_sphere_geometry_matches_yade(tmp_path):
     r = yade(script, tmp_path=tmp_path)
     # Settled, every grain touches something: at least 64 / 2 contacts.
     assert r["most"] >= 32 and r["checked"] > 10000 and r["fn_error"] < 1e-9 and r["slips"] > 0
+    # check=True also compared the law's contact set with YADE's every step: contacts were
+    # made and broken many times, and mostly found without reading the whole set.
+    assert r["set_checks"] == 6000 and r["changes"] > 500 and r["full_reads"] <= 60  # 1 measured
 
 
 REPLAY = """

@@ -66,7 +66,7 @@ def build(sc):
                                  rotateAroundZero=True, zeroPoint=Vector3(*r["pivot"]))
             rotators.append((eng, ids[w["name"]], r["steps"]))
     O.engines = stickslip_engines(ks=c["ks"], nu_s=c["nu_s"] if eff["tangential_damping"] else 0.0,
-                                  mu_s=c["mu_s"], mu_k=c["mu_k"], reset=c["reset"],
+                                  mu_s=c["mu_s"], mu_k=c["mu_k"], reset=c["reset"], slip_timing=c["slip_timing"],
                                   gravity=sc["gravity"] if eff["gravity"] else (0.0, 0.0, 0.0),
                                   rotation=eff["rotation"], extra=[e for e, _, _ in rotators])
     O.dt = sc["dt"]
@@ -98,16 +98,18 @@ def main(scene_path, out_path):
     if out["stats"]:
         header += ["n_contacts", "ekin"]
     slips = [0] * len(pairs)
+    last = [law.lookup(*key) for key, _ in pairs]  # each pair's (Fn, F_s, slipped) after the last step
 
     def row(step):
         r = [step * O.dt]
         for g in out["grains"]:
             s = O.bodies[ids[g]].state
-            r += [s.pos[k] for k in range(dim)] + [s.vel[k] for k in range(dim)]
+            r += list(s.pos.__getinitargs__()[:dim] + s.vel.__getinitargs__()[:dim])  # one read per vector
             if sc["effects"]["rotation"]:
-                r += [s.angVel[2]] if dim == 2 else [s.angVel[k] for k in range(3)]
+                w = s.angVel.__getinitargs__()
+                r += [w[2]] if dim == 2 else list(w)
         for k, (key, sign) in enumerate(pairs):
-            fn, f, _ = law.lookup(*key) or (0.0, (0.0, 0.0, 0.0), False)
+            fn, f, _ = last[k] or (0.0, (0.0, 0.0, 0.0), False)
             ft = [sign * f[q] for q in range(3)]
             r += [fn, math.sqrt(sum(x * x for x in ft))] + ft[:dim] + [slips[k]]
             slips[k] = 0
@@ -124,11 +126,10 @@ def main(scene_path, out_path):
     t0 = time.perf_counter()
     for step in range(1, steps + 1):
         O.step()
-        if pairs:
-            for k, (key, _) in enumerate(pairs):
-                got = law.lookup(*key)
-                if got is not None and got[2]:
-                    slips[k] += 1
+        for k, (key, _) in enumerate(pairs):
+            got = last[k] = law.lookup(*key)
+            if got is not None and got[2]:
+                slips[k] += 1
         if step in stop_at:  # the wall has turned to its stop angle: hold it there
             eng, bid = stop_at[step]
             eng.dead = True
@@ -136,6 +137,9 @@ def main(scene_path, out_path):
             O.bodies[bid].state.angVel = Vector3(0, 0, 0)
         if step % every == 0:
             rows.append(row(step))
+            bad = [h for h, v in zip(header, rows[-1]) if not math.isfinite(v)]
+            if bad:
+                raise RuntimeError(f"non-finite {', '.join(bad[:4])} at step {step} (t = {step * O.dt:g} s)")
         if step % 5000 == 0:
             print(f"PROGRESS {step} {steps}", flush=True)
     wall = time.perf_counter() - t0
@@ -146,10 +150,35 @@ def main(scene_path, out_path):
     print(f"WALLTIME {wall}", flush=True)
 
 
+def law_error(e):
+    """The law's own one-line message for an error raised inside its PyRunner (YADE wraps
+    it into "PyRunner error. COMMAND: ... ERROR: <message> ... STACK TRACE ...")."""
+    import builtins
+
+    law = getattr(builtins, "stickslip_law", None)
+    if law is not None and law.error:
+        return law.error
+    text = str(e)
+    if "ERROR:" in text:
+        text = text.split("ERROR:", 1)[1].strip()
+    return text.splitlines()[0] if text else type(e).__name__
+
+
 if __name__ == "__main__":
+    # One line on stdout for the adapter (and the user), the traceback only in the log.
+    import traceback
+
     try:
         main(sys.argv[1], sys.argv[2])
-    except ValueError as e:  # a bad parameter: one line, no traceback
+    except ValueError as e:  # a bad parameter
         print(f"ERROR {e}", flush=True)
         sys.exit(3)
+    except RuntimeError as e:  # the run failed (the law refused a scene, or values went non-finite)
+        traceback.print_exc(file=sys.stderr)
+        print(f"ERROR {law_error(e)}", flush=True)
+        sys.exit(4)
+    except Exception as e:  # noqa: BLE001 -- anything else, still one line
+        traceback.print_exc(file=sys.stderr)
+        print(f"ERROR run_scene.py: {type(e).__name__}: {e}", flush=True)
+        sys.exit(5)
     sys.exit(0)

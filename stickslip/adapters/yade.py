@@ -66,7 +66,7 @@ def run(scene, out_dir, progress=None):
     (work / "scene.json").write_text(json.dumps(scene_dict(scene), indent=1))
     csv_path = work / "timeseries_raw.csv"
     t0 = time.perf_counter()
-    wall = None
+    wall, error = None, None
     with open(work / "yade.log", "w") as log:
         env = dict(os.environ, STICKSLIP_YADE_LAW=str(RUNNER.parent))
         p = subprocess.Popen(["yade", "-n", "-x", str(RUNNER), str(work / "scene.json"), str(csv_path)],
@@ -78,9 +78,11 @@ def run(scene, out_dir, progress=None):
                 progress(done, total)
             elif line.startswith("WALLTIME"):
                 wall = float(line.split()[1])
-            elif line.startswith("ERROR"):
-                raise ValueError(line[6:].strip())
+            elif line.startswith("ERROR"):  # run_scene.py's one-line reason (bad value, failed run)
+                error = line[6:].strip()
         p.wait()
+    if error is not None:
+        raise (ValueError if p.returncode == 3 else RuntimeError)(error)
     if p.returncode != 0 or not csv_path.is_file():
         raise RuntimeError(f"yade failed (exit {p.returncode}); see {work / 'yade.log'}")
     df = pd.read_csv(csv_path)
