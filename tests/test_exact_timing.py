@@ -156,10 +156,13 @@ def test_thousands_of_slips_in_one_step_stay_finite_and_cheap(dim, monkeypatch):
 def test_drag_and_tray_agree_in_both_modes_within_half_a_percent():
     """The resolved cases: slips there follow >= 100 stick steps, so placing them inside
     the step moves the headline figures by O(1/100) of one tooth's share: under 0.5 %.
-    (Measured on the fall room rather than the height, the tray's step mode is ~1 % off
-    the converged answer at this dt and the exact mode 6e-5: docs/precision.md.)"""
+    The tray as the paper's statements left it is tray_wedge; in the tray calibrated on
+    the paper (grain 1 wedged 20 um deeper) the time to rest is set by the last
+    micro-slips, where the step timing is 5 % off the converged answer and the exact one
+    1.3 % (docs/precision.md): there the final height is compared."""
     for case, kw, keys in (("drag", {}, ("fs_fn_max", "fs_fn_min", "fs_fn_mean", "slip_period_s")),
-                           ("tray", {"duration": 0.5}, ("y1_final_m", "time_to_rest_s"))):
+                           ("tray_wedge", {"duration": 0.5}, ("y1_final_m", "time_to_rest_s")),
+                           ("tray", {"duration": 0.5}, ("y1_final_m",))):
         sc, df, _ = paper_case(case, **kw)
         step = analysis.summarise(sc, df)
         sc_exact = scene_mod.load(case, slip_timing="exact", **kw)
