@@ -31,8 +31,8 @@ MAX_EXPLICIT_SLIPS = 100
 @dataclass
 class LawParams:
     law: str  # stick_slip | visco_elastic | visco_plastic | coulomb
-    kn: float
-    nu_n: float  # 0 when normal damping is switched off
+    kn: float | None  # None: a caller with its own normal law (the YADE law) does not use it
+    nu_n: float | None  # 0 when normal damping is switched off
     ks: float
     nu_s: float  # 0 when tangential damping is switched off
     mu_s: float
@@ -49,26 +49,47 @@ class LawParams:
         return self.law in ("stick_slip", "visco_elastic")
 
     def check(self) -> None:
-        """The parameter rules of docs/law.md: ValueError naming the parameter and its
-        allowed range (the one checker of the Python engines; scenes prefix "contact.")."""
-        for name, allowed in (("law", LAWS), ("reset", RESETS), ("slip_timing", SLIP_TIMINGS)):
-            v = getattr(self, name)
-            if v not in allowed:
-                raise ValueError(f"{name} = {v!r}: must be one of {', '.join(allowed)}")
-        for name in ("kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, numbers.Real) or not math.isfinite(v):
-                raise ValueError(f"{name} = {v!r}: must be a finite number")
-        positive = ("kn", "mu_s") + (("ks",) if self.has_spring else ())
-        for name in ("kn", "ks", "mu_s", "nu_n", "nu_s", "mu_k"):
-            v = float(getattr(self, name))
-            if name in positive and not v > 0:
-                raise ValueError(f"{name} = {v:g}: must be > 0")
-            if v < 0:
-                raise ValueError(f"{name} = {v:g}: must be >= 0")
-        if self.law == "stick_slip" and not self.mu_s / 2 <= self.mu_k <= self.mu_s:
-            raise ValueError(f"mu_k = {self.mu_k:g}: must be in [mu_s/2, mu_s] = [{self.mu_s / 2:g}, {self.mu_s:g}] "
+        """The parameter rules of docs/law.md (check_parameters, all of them)."""
+        check_parameters(**{k: getattr(self, k) for k in self.__dataclass_fields__ if getattr(self, k) is not None})
+
+
+def check_parameters(law="stick_slip", **given) -> dict:
+    """The parameter rules of docs/law.md for the parameters given (kn, nu_n, ks, nu_s,
+    mu_s, mu_k, reset, slip_timing; mu_k needs mu_s): ValueError naming the parameter and
+    its allowed range. The one checker of the Python engines (scenes prefix "contact.",
+    the YADE law calls it with its arguments). Returns them, numbers as floats."""
+    unknown = set(given) - {"kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k", "reset", "slip_timing"}
+    if unknown:
+        raise TypeError(f"check_parameters: unknown parameter {sorted(unknown)[0]!r}")
+    if law not in LAWS:
+        raise ValueError(f"law = {law!r}: must be one of {', '.join(LAWS)}")
+    out = {}
+    for name in ("reset", "slip_timing"):
+        allowed = RESETS if name == "reset" else SLIP_TIMINGS
+        if name in given and given[name] not in allowed:
+            raise ValueError(f"{name} = {given[name]!r}: must be one of {', '.join(allowed)}")
+        if name in given:
+            out[name] = given[name]
+    positive = ("kn", "mu_s") + (("ks",) if law in ("stick_slip", "visco_elastic") else ())
+    for name in ("kn", "ks", "mu_s", "nu_n", "nu_s", "mu_k"):
+        if name not in given:
+            continue
+        v = given[name]
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real) or not math.isfinite(v):
+            raise ValueError(f"{name} = {v!r}: must be a finite number")
+        v = out[name] = float(v)
+        if name in positive and not v > 0:
+            raise ValueError(f"{name} = {v:g}: must be > 0")
+        if v < 0:
+            raise ValueError(f"{name} = {v:g}: must be >= 0")
+    if "mu_k" in out and law == "stick_slip":
+        if "mu_s" not in out:
+            raise ValueError("mu_k needs mu_s: the allowed range is [mu_s/2, mu_s]")
+        mu_s, mu_k = out["mu_s"], out["mu_k"]
+        if not mu_s / 2 <= mu_k <= mu_s:
+            raise ValueError(f"mu_k = {mu_k:g}: must be in [mu_s/2, mu_s] = [{mu_s / 2:g}, {mu_s:g}] "
                              f"so that 0 <= Fmin = (2 mu_k - mu_s) Fn <= mu_k Fn")
+    return out
 
 
 class TangentialStep(NamedTuple):

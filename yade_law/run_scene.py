@@ -80,23 +80,16 @@ def main(scene_path, out_path):
 
     law = builtins.stickslip_law
     dim, every, steps = sc["dimension"], sc["every"], sc["steps"]
-    axes = "xyz"[:dim]
     out = sc["output"]
-    header = ["t"]
-    for g in out["grains"]:
-        header += [f"{g}_{a}" for a in axes] + [f"{g}_v{a}" for a in axes]
-        if sc["effects"]["rotation"]:
-            header += [f"{g}_wz"] if dim == 2 else [f"{g}_w{a}" for a in axes]
+    # the column names come from stickslip/columns.py (through the adapter); the rows below
+    # give their values in that order (grains, contacts, walls, stats), checked at row 0
+    header = sc["columns"]
     pairs = []
     for a, b in out["contacts"]:
         ia, ib = ids[a], ids[b]
         key, sign = ((ia, ib), 1.0) if ia < ib else ((ib, ia), -1.0)
         pairs.append((key, sign))
-        header += [f"{a}-{b}_{q}" for q in ("fn", "fs")] + [f"{a}-{b}_ft{x}" for x in axes] + [f"{a}-{b}_slip"]
     wall_rot = {w["name"]: w["rotation"] for w in sc["walls"] if w.get("rotation")}
-    header += [f"{w}_angle" for w in out["walls"]]
-    if out["stats"]:
-        header += ["n_contacts", "ekin"]
     slips = [0] * len(pairs)
     last = [law.lookup(*key) for key, _ in pairs]  # each pair's (Fn, F_s, slipped) after the last step
 
@@ -122,6 +115,8 @@ def main(scene_path, out_path):
         return r
 
     rows = [row(0)]
+    if len(rows[0]) != len(header):
+        raise RuntimeError(f"run_scene.py writes {len(rows[0])} values a row for {len(header)} columns")
     stop_at = {n: (eng, bid) for eng, bid, n in rotators}
     t0 = time.perf_counter()
     for step in range(1, steps + 1):

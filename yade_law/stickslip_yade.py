@@ -72,32 +72,11 @@ def _number(name, v):
 
 def check_parameters(ks=None, nu_s=None, mu_s=None, mu_k=None, reset=None, slip_timing=None, kn=None,
                      nu_n=None):
-    """The law's parameter rules (docs/law.md), for the parameters given (None = not given).
-    Raises ValueError naming the parameter and its allowed range; returns the given values
-    as a dict of floats and strings (numpy scalars become floats)."""
-    out = {}
-    for name, v, low, strict in (("kn", kn, 0.0, True), ("nu_n", nu_n, 0.0, False), ("ks", ks, 0.0, True),
-                                 ("nu_s", nu_s, 0.0, False), ("mu_s", mu_s, 0.0, True)):
-        if v is None:
-            continue
-        v = out[name] = _number(name, v)
-        if v < low or (strict and v == low):
-            raise ValueError(f"{name} = {v:g}: must be {'>' if strict else '>='} {low:g}")
-    if mu_k is not None:
-        v = out["mu_k"] = _number("mu_k", mu_k)
-        if mu_s is None:
-            raise ValueError("mu_k needs mu_s: the allowed range is [mu_s/2, mu_s]")
-        mu_s = out["mu_s"]
-        if not mu_s / 2 <= v <= mu_s:
-            raise ValueError(f"mu_k = {v:g}: must be in [mu_s/2, mu_s] = [{mu_s / 2:g}, {mu_s:g}] "
-                             f"so that 0 <= Fmin = (2 mu_k - mu_s) Fn <= mu_k Fn")
-    for name, v, allowed in (("reset", reset, RESETS), ("slip_timing", slip_timing, SLIP_TIMINGS)):
-        if v is None:
-            continue
-        if not isinstance(v, str) or v not in allowed:
-            raise ValueError(f"{name} = {v!r}: must be one of {', '.join(allowed)}")
-        out[name] = v
-    return out
+    """The law's parameter rules (docs/law.md), for the parameters given (None = not given):
+    the kernel's one checker (pyref/laws.py). Raises ValueError naming the parameter and
+    its allowed range; returns the given values (numpy scalars become floats)."""
+    given = dict(ks=ks, nu_s=nu_s, mu_s=mu_s, mu_k=mu_k, reset=reset, slip_timing=slip_timing, kn=kn, nu_n=nu_n)
+    return _laws.check_parameters(**{k: v for k, v in given.items() if v is not None})
 
 
 def _flag(name, v):
@@ -203,7 +182,7 @@ class StickSlipLaw:
         self.ks, self.nu_s, self.mu_s, self.mu_k = p["ks"], p["nu_s"], p["mu_s"], p["mu_k"]
         self.reset, self.slip_timing = reset, slip_timing
         # The kernel's parameters; kn and nu_n are unused there (YADE's own law gives Fn).
-        self.params = LawParams("stick_slip", 0.0, 0.0, self.ks, self.nu_s, self.mu_s, self.mu_k, reset, slip_timing)
+        self.params = LawParams("stick_slip", None, None, self.ks, self.nu_s, self.mu_s, self.mu_k, reset, slip_timing)
         self.rotation = _flag("rotation", rotation)  # torques (and grain spin in V_s) only if rotation is simulated
         self.check = _flag("check", check)  # compare recomputed normals / normal forces with YADE's (tests, bench)
         self.max_fn_error = 0.0  # largest |Fn - native Fn| / max(native Fn) seen with check=True

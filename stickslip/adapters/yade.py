@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import columns
 from . import RunResult
 
 NAME = "yade"
@@ -51,6 +52,7 @@ def scene_dict(scene):
                     "angular_velocity": [float(c) for c in g.angular_velocity],
                     "imposed": list(g.imposed)} for g in scene.grains],
         "walls": walls,
+        "columns": columns.names(scene),
         "output": {"grains": scene.output.grains, "contacts": scene.output.contacts, "walls": scene.output.walls,
                    "stats": scene.output.stats},
     }
