@@ -20,6 +20,7 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 #include "update.h"
 #include "error.h"
 #include "neighbor.h"
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -60,6 +61,121 @@ namespace StickSlip {
     delete mu_s;
     return mu_k;
   }
+
+  // Exact slip timing (docs/law.md "Exact slip timing", E1-E7; pyref/laws.py _exact_slips is
+  // the reference, same branch order and constants). Slips are followed one by one until the
+  // force direction has settled along -V_s (its part across -V_s below SETTLED * mu_s Fn, so
+  // that it changes the slip level by less than round-off) or MAX_EXPLICIT_SLIPS slips have
+  // been followed in the step; the remaining slips of the step then have a closed form.
+  static const double SETTLED = 1e-8;
+  static const int MAX_EXPLICIT_SLIPS = 100;
+
+  inline double dot(const double * a, const double * b) { return a[0]*b[0] + a[1]*b[1] + a[2]*b[2]; }
+
+  /* E6: mu_k = mu_s, the force stays on |F| = T and turns towards u. With phi the angle
+     between F and u, tan(phi/2) falls as exp(-rate*theta/T); over the rest of the step by
+     exp(-k_rest). F is replaced by the force at the end of the step. */
+  inline void plastic_flow(double * F, const double * u, double k_rest, double T)
+  {
+    const double f = dot(F, u);
+    double q[3];
+    for (int k = 0; k < 3; k++) q[k] = F[k] - f * u[k];
+    const double qn = std::sqrt(dot(q, q));
+    const double s = qn / (T + f) * std::exp(-k_rest);  // tan(phi/2) at the end (f > 0 here)
+    const double c = (1.0 - s * s) / (1.0 + s * s), sn = 2.0 * s / (1.0 + s * s);
+    for (int k = 0; k < 3; k++) F[k] = (T * c) * u[k] + (T * sn) * (qn > 0.0 ? q[k] / qn : 0.0);
+  }
+
+  /* One step of a contact in which at least one slip happens (eqs. 5, 7, 8 integrated over
+     the step). V_s and Fn are constant over the step, so the trial force F = -Ks D - nu_s V_s
+     moves along u = -V_s/|V_s| at `rate` = Ks |V_s| dt per unit of step fraction theta.
+     In: F0, the trial force at theta = 0 (D turned, not yet incremented). Out: the force at
+     the end of the step (the one applied, as in a step without slip), the trial force at
+     the end (spring + dashpot) and the share of the step spent sticking. */
+  inline void exact_slips(const double * F0, const double * vs, double T, double fmin, double r,
+                          double kt, double gammat, double dt, bool reset_total, bool flow_law,
+                          double * applied, double * trial, double & stick)
+  {
+    const double speed = std::sqrt(dot(vs, vs));
+    double u[3];
+    for (int k = 0; k < 3; k++) u[k] = speed > 0.0 ? -vs[k] / speed : 0.0;
+    const double rate = kt * speed * dt;
+    // after a slip the trial force restarts from Fmin t + kept u (E3): the spring holds Fmin
+    // and the dashpot adds nu_s |V_s| (default reset), or both hold Fmin (slip_reset_total)
+    const double kept = reset_total ? 0.0 : gammat * speed;
+    stick = 0.0;
+    if (!(T > 0.0)) {  // E1: no normal force, no friction; the spring keeps what the reset leaves
+      for (int k = 0; k < 3; k++) { applied[k] = 0.0; trial[k] = kept * u[k]; }
+      return;
+    }
+    double F[3] = { F0[0], F0[1], F0[2] };
+    double theta = 0.0;
+    for (int slips = 0; ; ) {
+      // E2: the next slip, where |F + rate dtheta u| reaches T (the larger root); before the
+      // step's first slip the force may already be at or above T (Fn fell): slip at once
+      const double f = dot(F, u), F2 = dot(F, F);
+      double dtheta;
+      if (slips == 0 && F2 >= T * T) dtheta = 0.0;
+      else {
+        const double gap = std::max(std::sqrt(std::max(T * T - (F2 - f * f), 0.0)) - f, 0.0);
+        dtheta = rate > 0.0 ? gap / rate : INFINITY;
+      }
+      if (!(theta + dtheta <= 1.0)) {  // sticks to the end of the step
+        const double rest = 1.0 - theta;
+        for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];
+        stick += rest;
+        return;
+      }
+      double hit[3];
+      for (int k = 0; k < 3; k++) hit[k] = F[k] + (rate * dtheta) * u[k];
+      stick += dtheta;
+      theta += dtheta;
+      // E3: the slip; the force drops to Fmin along its direction t, the spring is reset (eq. 8)
+      const double hn = std::sqrt(dot(hit, hit));
+      double t[3];
+      for (int k = 0; k < 3; k++) t[k] = hit[k] / hn;
+      slips++;
+      for (int k = 0; k < 3; k++) F[k] = fmin * t[k] + kept * u[k];
+      const double rest = 1.0 - theta;
+      // E4: the restarted force is at or above T again: slips follow without end and turn t
+      // onto u, the contact slides at Fmin u for the rest of the step
+      if (kept > 0.0 && dot(F, F) >= T * T) {
+        for (int k = 0; k < 3; k++) { trial[k] = (fmin + kept) * u[k]; applied[k] = fmin * u[k]; }
+        return;
+      }
+      if (rate == 0.0) {  // E5: nothing moves, the force stays where the slip left it
+        for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
+        stick += rest;
+        return;
+      }
+      const double along = dot(t, u);
+      if (flow_law && along > 0.0) {  // E6: plastic flow on |F| = T
+        plastic_flow(F, u, rate * rest / T, T);
+        for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
+        return;
+      }
+      // E7: settled along u (or followed MAX_EXPLICIT_SLIPS times): the remaining slips of
+      // the step repeat one cycle (Fmin + kept) u -> T u, of length L in theta; the part q of
+      // the force across u shrinks by r at each slip
+      const double fu = dot(F, u);
+      double q[3];
+      for (int k = 0; k < 3; k++) q[k] = F[k] - fu * u[k];
+      if ((std::sqrt(dot(q, q)) <= SETTLED * T && along > 0.0) || slips >= MAX_EXPLICIT_SLIPS) {
+        const double low = fmin + kept;
+        const double L = (T - low) / rate;
+        if (!(L > 0.0)) {  // restarts at T: slides, as E4
+          for (int k = 0; k < 3; k++) { trial[k] = low * u[k]; applied[k] = fmin * u[k]; }
+          return;
+        }
+        const double n = std::floor(rest / L);
+        const double part = rest - n * L;
+        const double shrink = std::pow(r, n);
+        for (int k = 0; k < 3; k++) applied[k] = trial[k] = (low + rate * part) * u[k] + shrink * q[k];
+        stick += rest;
+        return;
+      }
+    }
+  }
 }
 
 template<>
@@ -71,11 +187,12 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
   int record_offset;    // optional diagnostics: Fn, F_s (3), slip count
   bool reset_total;     // eq. 8: false = spring alone carries Fmin (paper), true = spring + dashpot
   bool record;
+  bool exact;           // slips at their exact time inside the step (docs/law.md E0-E7)
 
 public:
   TangentialModel(LAMMPS * lmp, IContactHistorySetup * hsetup, class ContactModelBase * c) :
     TangentialModelBase(lmp, hsetup, c), mu_s(NULL), mu_k(NULL), history_offset(-1), record_offset(-1),
-    reset_total(false), record(false)
+    reset_total(false), record(false), exact(false)
   {
     // "1": the value changes sign when the pair is seen from the other grain
     history_offset = hsetup->add_history_value("shearx", "1");
@@ -87,6 +204,7 @@ public:
   {
     settings.registerOnOff("slip_reset_total", reset_total, false);
     settings.registerOnOff("stick_slip_record", record, false);
+    settings.registerOnOff("exact_slip_timing", exact, false);
   }
 
   inline void postSettings(IContactHistorySetup * hsetup, ContactModelBase *)
@@ -132,6 +250,7 @@ public:
 
     double * const hist = &sidata.contact_history[history_offset];
     double D[3] = { hist[0], hist[1], hist[2] };
+    double D0[3];  // D turned into the tangent plane, before the increment (exact timing)
     if (update_history) {
       // 3D form: turn D into the current tangent plane, keeping its length
       const double dn = D[0]*en[0] + D[1]*en[1] + D[2]*en[2];
@@ -145,7 +264,10 @@ public:
         }
       }
       const double dt = update->dt;
-      for (int k = 0; k < 3; k++) D[k] += vs[k] * dt;  // eq. 7
+      for (int k = 0; k < 3; k++) {
+        D0[k] = D[k];
+        D[k] += vs[k] * dt;  // eq. 7
+      }
     }
 
     // eq. 5: trial force = spring + dashpot
@@ -156,8 +278,29 @@ public:
     const double limit = ms * fn;
     // static threshold reached (Fn = 0 always slips); squared, so that a sticking step
     // (the common case) needs no square root
-    const bool slip = mag2 >= limit * limit;
-    if (slip) {
+    bool slip = mag2 >= limit * limit;
+    if (exact) {
+      // E0: |F| moves on a line during the step and is convex in time, so the step has no
+      // slip iff it is below the threshold at both ends; then it is exactly the step above.
+      // A re-evaluation without history update (run setup, computes) is a step of length 0.
+      const double dt = update_history ? update->dt : 0.0;
+      if (!update_history)
+        for (int k = 0; k < 3; k++) D0[k] = D[k];
+      double F0[3];
+      for (int k = 0; k < 3; k++) F0[k] = -kt * D0[k] - gammat * vs[k];
+      slip = slip || StickSlip::dot(F0, F0) >= limit * limit;
+      if (slip) {
+        const double mk = mu_k[sidata.itype][sidata.jtype];
+        const double fmin = (2.0 * mk - ms) * fn;
+        const double r = (2.0 * mk - ms) / ms;  // Fmin/T, exactly 1 iff mu_k = mu_s
+        // E6 applies when nothing is added at the reset (slip_reset_total, or no dashpot)
+        const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);
+        double trial[3], stick;
+        StickSlip::exact_slips(F0, vs, limit, fmin, r, kt, gammat, dt, reset_total, flow_law, F, trial, stick);
+        // the spring at the end holds the trial force less the dashpot (eq. 5)
+        for (int k = 0; k < 3; k++) D[k] = -(trial[k] + gammat * vs[k]) / kt;
+      }
+    } else if (slip) {
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) Fn along the trial force
       const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;
       const double scale = mag2 > 0.0 ? fmin / std::sqrt(mag2) : 0.0;

@@ -794,3 +794,28 @@ def test_drag2d_sawtooth(tmp_path, reset):
           f"interval {np.diff(slip_steps).min()}-{np.diff(slip_steps).max()} steps "
           f"(T/dt = {T / dt:.2f}, window [{lo / dt:.2f}, {hi / dt:.2f}]); mean |Fs|/Fn from the first slip "
           f"{ratio[steps >= first].mean():.5f}")
+
+
+def test_exact_timing_without_slip_is_the_step_mode(tmp_path):
+    """`exact_slip_timing on` (docs/law.md E0): a step in which no slip happens computes
+    exactly what the default mode computes. The drag's first slip comes at step ~830 (the
+    trial force reaches mu_s Fn); up to step 800 the two modes' dumps must be identical
+    byte for byte, and the first slip must make them differ (else the option did nothing)."""
+    settings = "absolute_damping on limitForce on stick_slip_record on"
+    body = ("dump d all custom 1 dump.drag id x y vx vy f_force_floor[1] f_force_floor[2] f_history_floor[8]\n"
+            f'dump_modify d sort id format "%d {F17(7)}"\nrun @N@\n')
+    dumps = {}
+    for n in (800, 1000):
+        for mode in ("off", "on"):
+            d = tmp_path / f"{mode}{n}"
+            d.mkdir()
+            s = settings + f" exact_slip_timing {mode}"
+            run_liggghts(d, "drag", drag_script(pair_settings=s, wall_settings=s, body=body.replace("@N@", str(n))))
+            dumps[mode, n] = read_dump(d / "dump.drag")
+    assert (tmp_path / "off800" / "dump.drag").read_bytes() == (tmp_path / "on800" / "dump.drag").read_bytes()
+    assert dumps["off", 800][800][0][7] == 0, "no slip before step 800"
+    first = min(k for k in dumps["on", 1000] if not np.array_equal(dumps["on", 1000][k], dumps["off", 1000][k]))
+    slips = [k for k in sorted(dumps["on", 1000]) if dumps["on", 1000][k][0][7] > 0]
+    print(f"\n[exact vs step] identical through step 800; first difference at step {first}, first slip (exact) "
+          f"at step {slips[0]}")
+    assert first == slips[0]
