@@ -1,112 +1,134 @@
 /* Registers `tangential stick_slip` with the installed LIGGGHTS library when this
-   shared object is loaded (static initializer): the model name, and one pair style
-   and one wall style per supported combination of normal and rolling model.
+   shared object is loaded (static initializer): the model name, and one pair style and
+   one wall style for every combination of surface, normal, cohesion and rolling model
+   that the library itself offers with stock `tangential history`. That list is read
+   from the library's symbols when the plugin is configured (CMakeLists.txt writes it to
+   stick_slip_combinations.h); the styles are compiled and registered in register_combinations.cpp.
    Every other combination with stick_slip is registered too, as a creator that stops
-   with an error listing the supported ones (the library would otherwise say only
-   "Unknown tangential model"). */
+   with an error naming the refused part and the command that asked for it (the library
+   would otherwise say only "Unknown tangential model"). */
 
-#include <mpi.h>
-#include "fix_insert_stream.h"  // must precede pair_gran_base.h (a stub header otherwise fails)
-#include "contact_models.h"
-#include "granular_pair_style.h"
-#include "granular_wall.h"
-#include "pair_gran_base.h"
-#include "fix_wall_gran_base.h"
-#include "error.h"
+#include "stick_slip_styles.h"
+#include <cstdio>
 #include <set>
-#include "tangential_model_stick_slip.h"
+#include <string>
 
 using namespace LIGGGHTS;
 using namespace LIGGGHTS::ContactModels;
 
 namespace {
 
-const char SUPPORTED[] =
-    "tangential stick_slip supports: model hooke, hooke/stiffness, hertz or hertz/stiffness; "
-    "rolling_friction off, cdt, epsd, epsd2 or epsd3; no cohesion model; the default surface model";
+struct Named { int id; const char * name; };
 
-template<int M, int R>
-struct Combination {
-  typedef GranStyle<M, TANGENTIAL_STICK_SLIP, COHESION_OFF, R, SURFACE_DEFAULT> Style;
-  typedef ContactModel<Style> Model;
-
-  static PairStyles::IGranularPairStyle * pair(LAMMPS * lmp, PairGran * parent, int64_t hash)
-  { return new PairStyles::Granular<Model>(lmp, parent, hash); }
-
-  static Walls::IGranularWall * wall(LAMMPS * lmp, FixWallGran * parent, int64_t hash)
-  { return new Walls::Granular<Model>(lmp, parent, hash); }
-
-  static void add(std::set<int64_t> & done)
-  {
-    const int64_t hash = Style::HASHCODE;  // a copy: the static member has no definition to bind to
-    PairStyles::Factory::instance().addStyle("gran", hash, &pair);
-    Walls::Factory::instance().addStyle("gran", hash, &wall);
-    done.insert(hash);
-  }
+const Named NORMAL[] = {
+#define NORMAL_MODEL(CONST, NAME, ID) { CONST, #NAME },
+#include "style_normal_model.h"
+#undef NORMAL_MODEL
+};
+const Named COHESION[] = {
+#define COHESION_MODEL(CONST, NAME, ID) { CONST, #NAME },
+#include "style_cohesion_model.h"
+#undef COHESION_MODEL
+};
+const Named ROLLING[] = {
+#define ROLLING_MODEL(CONST, NAME, ID) { CONST, #NAME },
+#include "style_rolling_model.h"
+#undef ROLLING_MODEL
+};
+const Named SURFACE[] = {
+#define SURFACE_MODEL(CONST, NAME, ID) { CONST, #NAME },
+#include "style_surface_model.h"
+#undef SURFACE_MODEL
 };
 
-PairStyles::IGranularPairStyle * unsupported_pair(LAMMPS * lmp, PairGran *, int64_t)
+template<size_t N>
+std::string name_of(const Named (&list)[N], int id, const char * off)
 {
-  lmp->error->all(FLERR, SUPPORTED);
+  for (size_t k = 0; k < N; k++)
+    if (list[k].id == id) return list[k].name;
+  return off;
+}
+
+struct Combo { int m, c, r, s; bool pair, wall; };
+
+// the library's own combinations with tangential history (generated at configure time)
+const Combo SUPPORTED[] = {
+#define STICK_SLIP_COMBINATION(M, C, R, S, PAIR, WALL) { M, C, R, S, PAIR, WALL },
+#include "stick_slip_combinations.h"
+#undef STICK_SLIP_COMBINATION
+};
+const size_t NSUPPORTED = sizeof SUPPORTED / sizeof *SUPPORTED;
+
+/* The part of a refused combination that stock history never comes with (or the
+   combination itself when each part does, but not together). */
+std::string refused_part(int64_t hash, bool wall)
+{
+  const int m = hash & 63, c = (hash >> 12) & 63, r = (hash >> 18) & 63, s = (hash >> 24) & 63;
+  bool m_ok = false, c_ok = false, r_ok = false, s_ok = false;
+  for (size_t k = 0; k < NSUPPORTED; k++) {
+    const Combo & x = SUPPORTED[k];
+    if (!(wall ? x.wall : x.pair)) continue;
+    m_ok |= x.m == m; c_ok |= x.c == c; r_ok |= x.r == r; s_ok |= x.s == s;
+  }
+  const std::string M = "model " + name_of(NORMAL, m, "off"), C = "cohesion " + name_of(COHESION, c, "off"),
+                    R = "rolling_friction " + name_of(ROLLING, r, "off"), S = "surface " + name_of(SURFACE, s, "default");
+  std::string parts;
+  if (!m_ok) parts += (parts.empty() ? "" : ", ") + M;
+  if (!c_ok) parts += (parts.empty() ? "" : ", ") + C;
+  if (!r_ok) parts += (parts.empty() ? "" : ", ") + R;
+  if (!s_ok) parts += (parts.empty() ? "" : ", ") + S;
+  if (!parts.empty()) return parts + " (not built with tangential history in this LIGGGHTS either)";
+  return "the combination " + M + ", " + C + ", " + R + ", " + S +
+         " (each part exists, but this LIGGGHTS has no tangential history built with them together)";
+}
+
+void refuse(LAMMPS * lmp, const std::string & command, int64_t hash, bool wall)
+{
+  const std::string msg = command + ": tangential stick_slip cannot be combined with " + refused_part(hash, wall) +
+      "; it supports the combinations this LIGGGHTS builds with tangential history";
+  lmp->error->all(FLERR, msg.c_str());
+}
+
+PairStyles::IGranularPairStyle * unsupported_pair(LAMMPS * lmp, PairGran *, int64_t hash)
+{
+  refuse(lmp, "pair_style gran", hash, false);
   return NULL;
 }
 
-Walls::IGranularWall * unsupported_wall(LAMMPS * lmp, FixWallGran *, int64_t)
+Walls::IGranularWall * unsupported_wall(LAMMPS * lmp, FixWallGran * parent, int64_t hash)
 {
-  lmp->error->all(FLERR, SUPPORTED);
+  refuse(lmp, std::string("fix ") + parent->id + " " + parent->style, hash, true);
   return NULL;
-}
-
-template<int R>
-void add_normal_models(std::set<int64_t> & done)
-{
-  Combination<HOOKE, R>::add(done);
-  Combination<HOOKE_STIFFNESS, R>::add(done);
-  Combination<HERTZ, R>::add(done);
-  Combination<HERTZ_STIFFNESS, R>::add(done);
 }
 
 struct RegisterStickSlip {
   RegisterStickSlip()
   {
+    // LIGGGHTS stops on an error of one process with MPI_Abort, which drops what is still
+    // buffered: with stdout redirected to a file or pipe the ERROR line would be lost.
+    // Line buffering writes each line out at once (nothing has been printed yet here).
+    setvbuf(stdout, NULL, _IOLBF, BUFSIZ);
+
     Factory::instance().addTangentialModel("stick_slip", TANGENTIAL_STICK_SLIP);
+    // the supported combinations register themselves (register_combinations.cpp)
 
-    std::set<int64_t> supported;
-    add_normal_models<ROLLING_OFF>(supported);
-    add_normal_models<ROLLING_CDT>(supported);
-    add_normal_models<ROLLING_EPSD>(supported);
-    add_normal_models<ROLLING_EPSD2>(supported);
-    add_normal_models<ROLLING_EPSD3>(supported);
-
-    // every other combination with stick_slip stops with the list above
-    const int normal[] = { NORMAL_OFF,
-#define NORMAL_MODEL(ID, NAME, CONST) ID,
-#include "style_normal_model.h"
-#undef NORMAL_MODEL
-    };
-    const int cohesion[] = { COHESION_OFF,
-#define COHESION_MODEL(ID, NAME, CONST) ID,
-#include "style_cohesion_model.h"
-#undef COHESION_MODEL
-    };
-    const int rolling[] = { ROLLING_OFF,
-#define ROLLING_MODEL(ID, NAME, CONST) ID,
-#include "style_rolling_model.h"
-#undef ROLLING_MODEL
-    };
-    const int surface[] = {
-#define SURFACE_MODEL(ID, NAME, CONST) ID,
-#include "style_surface_model.h"
-#undef SURFACE_MODEL
-    };
-    for (size_t m = 0; m < sizeof normal / sizeof *normal; m++)
-      for (size_t c = 0; c < sizeof cohesion / sizeof *cohesion; c++)
-        for (size_t r = 0; r < sizeof rolling / sizeof *rolling; r++)
-          for (size_t s = 0; s < sizeof surface / sizeof *surface; s++) {
-            const int64_t hash = Utils::generate_gran_hashcode(normal[m], TANGENTIAL_STICK_SLIP, cohesion[c], rolling[r], surface[s]);
-            if (supported.count(hash)) continue;
-            PairStyles::Factory::instance().addStyle("gran", hash, &unsupported_pair);
-            Walls::Factory::instance().addStyle("gran", hash, &unsupported_wall);
+    std::set<int64_t> pair, wall;
+    for (size_t k = 0; k < NSUPPORTED; k++) {
+      const Combo & x = SUPPORTED[k];
+      const int64_t hash = Utils::generate_gran_hashcode(x.m, TANGENTIAL_STICK_SLIP, x.c, x.r, x.s);
+      if (x.pair) pair.insert(hash);
+      if (x.wall) wall.insert(hash);
+    }
+    // every other combination with stick_slip stops with an error
+    for (size_t m = 0; m <= sizeof NORMAL / sizeof *NORMAL; m++)
+      for (size_t c = 0; c <= sizeof COHESION / sizeof *COHESION; c++)
+        for (size_t r = 0; r <= sizeof ROLLING / sizeof *ROLLING; r++)
+          for (size_t s = 0; s < sizeof SURFACE / sizeof *SURFACE; s++) {
+            const int mid = m ? NORMAL[m - 1].id : NORMAL_OFF, cid = c ? COHESION[c - 1].id : COHESION_OFF,
+                      rid = r ? ROLLING[r - 1].id : ROLLING_OFF;
+            const int64_t hash = Utils::generate_gran_hashcode(mid, TANGENTIAL_STICK_SLIP, cid, rid, SURFACE[s].id);
+            if (!pair.count(hash)) PairStyles::Factory::instance().addStyle("gran", hash, &unsupported_pair);
+            if (!wall.count(hash)) Walls::Factory::instance().addStyle("gran", hash, &unsupported_wall);
           }
   }
 };

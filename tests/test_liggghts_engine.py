@@ -337,7 +337,7 @@ def test_exact_timing_thousands_of_slips_per_step(tmp_path):
     that round-off scrambles, so only the mean is compared: the samples are uniform on
     [Fmin, mu_s Fn), mean mu_k Fn, standard error (mu_s - Fmin/Fn)/sqrt(12 N) of the ratio;
     LIGGGHTS and pyref within 4 standard errors (sqrt 2 for the difference of two) of it.
-    - 2D: the drag at 1 m/s (mu_k = 0.4999 mu_s... the drop is 2e-4 Fn), force along -V_s;
+    - 2D: the drag at 1 m/s (mu_s = 0.5, mu_k = 0.4999: the drop is 2e-4 Fn), force along -V_s;
     - 3D: the inclined plane at 1 m/s across the slope, V_s turning: the part of the
       force across -V_s shrinks by r = Fmin/(mu_s Fn) = 0.9996 per slip, so the step
       follows 100 slips before closing the rest (MAX_EXPLICIT_SLIPS)."""

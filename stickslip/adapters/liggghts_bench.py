@@ -94,16 +94,16 @@ run {settle}
 write_data {out}
 """
 
-# The timed script: identical for both models but for ${tang}.
+# The timed script: identical for all configurations but for ${tang} and ${extra}.
 TIMED = HEADER + """\
 read_data {data}
 neighbor 0.0003 bin
 neigh_modify delay 0
 """ + MATERIAL + """\
-pair_style gran model hooke/stiffness tangential ${{tang}} absolute_damping on limitForce on
+pair_style gran model hooke/stiffness tangential ${{tang}} absolute_damping on limitForce on ${{extra}}
 pair_coeff * *
 timestep 5e-6
-fix floor all wall/gran model hooke/stiffness tangential ${{tang}} primitive type 1 zplane 0.0 absolute_damping on limitForce on
+fix floor all wall/gran model hooke/stiffness tangential ${{tang}} primitive type 1 zplane 0.0 absolute_damping on limitForce on ${{extra}}
 fix grav all gravity 9.81 vector 0 0 -1
 fix integr all nve/sphere
 compute c all contact/atom
@@ -141,9 +141,10 @@ dump d all local 1 {dump} {columns}
 run 1
 """
 
-# what each configuration puts after `tangential` (the settings may follow the model name)
-TANGENTIAL = {"history": "history", "stick_slip": "stick_slip",
-              "stick_slip_exact": "stick_slip exact_slip_timing on"}
+# each configuration: the tangential model, and a setting appended to the pair and wall
+# lines (fix wall/gran takes the settings last; "limitForce on" repeats one already there)
+TANGENTIAL = {"history": ("history", "limitForce on"), "stick_slip": ("stick_slip", "limitForce on"),
+              "stick_slip_exact": ("stick_slip", "exact_slip_timing on")}
 
 NOISY = 0.1  # cores used by other processes during a run above which it is re-run (within a budget)
 LAST_RUNS = {}  # (tangential model, processes) -> the runs behind the last benchmark() figures
@@ -267,7 +268,8 @@ def _timed(data, tang, nproc, work):
     d = work / f"{tang}-np{nproc}"
     d.mkdir(exist_ok=True)
     (d / "in.timed").write_text(TIMED.format(data=data, warm=WARM, steps=STEPS))
-    cmd = [str(LAUNCHER), "-in", "in.timed", "-log", "none", "-var", "tang", TANGENTIAL[tang]]
+    model, extra = TANGENTIAL[tang]
+    cmd = [str(LAUNCHER), "-in", "in.timed", "-log", "none", "-var", "tang", model, "-var", "extra", extra]
     if nproc > 1:
         cmd = ["mpirun", "-np", str(nproc)] + cmd
     info = {}
