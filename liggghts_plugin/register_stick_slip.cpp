@@ -4,9 +4,9 @@
    that the library itself offers with stock `tangential history`. That list is read
    from the library's symbols when the plugin is configured (CMakeLists.txt writes it to
    stick_slip_combinations.h); the styles are compiled and registered in register_combinations.cpp.
-   Every other combination with stick_slip is registered too, as a creator that stops
-   with an error naming the refused part and the command that asked for it (the library
-   would otherwise say only "Unknown tangential model"). */
+   Every other combination with stick_slip runs through LIGGGHTS' generic contact model,
+   as stock history's do (model off, which cannot work, stops with an error naming it and
+   the command that asked for it). */
 
 #include "stick_slip_styles.h"
 #include <cstdio>
@@ -18,36 +18,27 @@ using namespace LIGGGHTS::ContactModels;
 
 namespace {
 
-struct Named { int id; const char * name; };
-
-const Named NORMAL[] = {
-#define NORMAL_MODEL(CONST, NAME, ID) { CONST, #NAME },
+// the model ids this LIGGGHTS knows (its installed model headers)
+const int NORMAL[] = {
+#define NORMAL_MODEL(CONST, NAME, ID) CONST,
 #include "style_normal_model.h"
 #undef NORMAL_MODEL
 };
-const Named COHESION[] = {
-#define COHESION_MODEL(CONST, NAME, ID) { CONST, #NAME },
+const int COHESION[] = {
+#define COHESION_MODEL(CONST, NAME, ID) CONST,
 #include "style_cohesion_model.h"
 #undef COHESION_MODEL
 };
-const Named ROLLING[] = {
-#define ROLLING_MODEL(CONST, NAME, ID) { CONST, #NAME },
+const int ROLLING[] = {
+#define ROLLING_MODEL(CONST, NAME, ID) CONST,
 #include "style_rolling_model.h"
 #undef ROLLING_MODEL
 };
-const Named SURFACE[] = {
-#define SURFACE_MODEL(CONST, NAME, ID) { CONST, #NAME },
+const int SURFACE[] = {
+#define SURFACE_MODEL(CONST, NAME, ID) CONST,
 #include "style_surface_model.h"
 #undef SURFACE_MODEL
 };
-
-template<size_t N>
-std::string name_of(const Named (&list)[N], int id, const char * off)
-{
-  for (size_t k = 0; k < N; k++)
-    if (list[k].id == id) return list[k].name;
-  return off;
-}
 
 struct Combo { int m, c, r, s; bool pair, wall; };
 
@@ -59,46 +50,30 @@ const Combo SUPPORTED[] = {
 };
 const size_t NSUPPORTED = sizeof SUPPORTED / sizeof *SUPPORTED;
 
-/* The part of a refused combination that stock history never comes with (or the
-   combination itself when each part does, but not together). */
-std::string refused_part(int64_t hash, bool wall)
-{
-  const int m = hash & 63, c = (hash >> 12) & 63, r = (hash >> 18) & 63, s = (hash >> 24) & 63;
-  bool m_ok = false, c_ok = false, r_ok = false, s_ok = false;
-  for (size_t k = 0; k < NSUPPORTED; k++) {
-    const Combo & x = SUPPORTED[k];
-    if (!(wall ? x.wall : x.pair)) continue;
-    m_ok |= x.m == m; c_ok |= x.c == c; r_ok |= x.r == r; s_ok |= x.s == s;
-  }
-  const std::string M = "model " + name_of(NORMAL, m, "off"), C = "cohesion " + name_of(COHESION, c, "off"),
-                    R = "rolling_friction " + name_of(ROLLING, r, "off"), S = "surface " + name_of(SURFACE, s, "default");
-  std::string parts;
-  if (!m_ok) parts += (parts.empty() ? "" : ", ") + M;
-  if (!c_ok) parts += (parts.empty() ? "" : ", ") + C;
-  if (!r_ok) parts += (parts.empty() ? "" : ", ") + R;
-  if (!s_ok) parts += (parts.empty() ? "" : ", ") + S;
-  if (!parts.empty()) return parts + " (not built with tangential history in this LIGGGHTS either)";
-  return "the combination " + M + ", " + C + ", " + R + ", " + S +
-         " (each part exists, but this LIGGGHTS has no tangential history built with them together)";
-}
+/* A combination the library has no compiled-in version of: LIGGGHTS runs those through its
+   generic contact model, which picks each part at run time (and warns that it is slower);
+   stock history does so for every combination outside its list. stick_slip does the same
+   with its own copy of the generic model (it knows stick_slip). The one combination that
+   cannot work is the one without a normal model: stick_slip takes Fn, Ks and nu_s from it. */
+typedef ContactModel<GranStyle<> > Generic;
 
-void refuse(LAMMPS * lmp, const std::string & command, int64_t hash, bool wall)
+void refuse_without_normal_model(LAMMPS * lmp, const std::string & command)
 {
-  const std::string msg = command + ": tangential stick_slip cannot be combined with " + refused_part(hash, wall) +
-      "; it supports the combinations this LIGGGHTS builds with tangential history";
+  const std::string msg = command + ": tangential stick_slip cannot be combined with model off (no normal "
+      "model): it takes Fn, kt and the tangential damping from the normal model";
   lmp->error->all(FLERR, msg.c_str());
 }
 
-PairStyles::IGranularPairStyle * unsupported_pair(LAMMPS * lmp, PairGran *, int64_t hash)
+PairStyles::IGranularPairStyle * generic_pair(LAMMPS * lmp, PairGran * parent, int64_t hash)
 {
-  refuse(lmp, "pair_style gran", hash, false);
-  return NULL;
+  if ((hash & 63) == NORMAL_OFF) refuse_without_normal_model(lmp, "pair_style gran");
+  return new LIGGGHTS::StickSlip::PairStyle<Generic>(lmp, parent, hash);
 }
 
-Walls::IGranularWall * unsupported_wall(LAMMPS * lmp, FixWallGran * parent, int64_t hash)
+Walls::IGranularWall * generic_wall(LAMMPS * lmp, FixWallGran * parent, int64_t hash)
 {
-  refuse(lmp, std::string("fix ") + parent->id + " " + parent->style, hash, true);
-  return NULL;
+  if ((hash & 63) == NORMAL_OFF) refuse_without_normal_model(lmp, std::string("fix ") + parent->id + " " + parent->style);
+  return new LIGGGHTS::StickSlip::WallStyle<Generic>(lmp, parent, hash);
 }
 
 struct RegisterStickSlip {
@@ -119,16 +94,16 @@ struct RegisterStickSlip {
       if (x.pair) pair.insert(hash);
       if (x.wall) wall.insert(hash);
     }
-    // every other combination with stick_slip stops with an error
+    // every other combination with stick_slip: the generic model (or an error, see above)
     for (size_t m = 0; m <= sizeof NORMAL / sizeof *NORMAL; m++)
       for (size_t c = 0; c <= sizeof COHESION / sizeof *COHESION; c++)
         for (size_t r = 0; r <= sizeof ROLLING / sizeof *ROLLING; r++)
           for (size_t s = 0; s < sizeof SURFACE / sizeof *SURFACE; s++) {
-            const int mid = m ? NORMAL[m - 1].id : NORMAL_OFF, cid = c ? COHESION[c - 1].id : COHESION_OFF,
-                      rid = r ? ROLLING[r - 1].id : ROLLING_OFF;
-            const int64_t hash = Utils::generate_gran_hashcode(mid, TANGENTIAL_STICK_SLIP, cid, rid, SURFACE[s].id);
-            if (!pair.count(hash)) PairStyles::Factory::instance().addStyle("gran", hash, &unsupported_pair);
-            if (!wall.count(hash)) Walls::Factory::instance().addStyle("gran", hash, &unsupported_wall);
+            const int mid = m ? NORMAL[m - 1] : NORMAL_OFF, cid = c ? COHESION[c - 1] : COHESION_OFF,
+                      rid = r ? ROLLING[r - 1] : ROLLING_OFF;
+            const int64_t hash = Utils::generate_gran_hashcode(mid, TANGENTIAL_STICK_SLIP, cid, rid, SURFACE[s]);
+            if (!pair.count(hash)) PairStyles::Factory::instance().addStyle("gran", hash, &generic_pair);
+            if (!wall.count(hash)) Walls::Factory::instance().addStyle("gran", hash, &generic_wall);
           }
   }
 };

@@ -104,7 +104,9 @@ namespace StickSlip {
      In: F0, the trial force at theta = 0 (D turned, not yet incremented). Out: the force at
      the end of the step (the one applied, as in a step without slip), the trial force at
      the end (spring + dashpot) and the share of the step spent sticking. */
-  inline void exact_slips(const double * F0, const double * vs, double T, double fmin, double r,
+  // (kept out of line: it runs only in steps that slip, and inlined it would crowd the
+  // common sticking step's code)
+  inline __attribute__((noinline)) void exact_slips(const double * F0, const double * vs, double T, double fmin, double r,
                           double kt, double gammat, double dt, bool reset_total, bool flow_law,
                           double * applied, double * trial, double & stick)
   {
@@ -432,7 +434,7 @@ public:
      the normal model's elastic-potential history, the dissipative part of the force into
      the per-atom dissipated_energy property; the energy itself is added to that
      property's first value, "energy" (half to each grain of a pair). */
-  inline void account_energy(const SurfacesIntersectData & sidata, const double * F, const double * D,
+  __attribute__((noinline)) void account_energy(const SurfacesIntersectData & sidata, const double * F, const double * D,
                              const double * vs, double kt, double gammat, double spring_before, double stick)
   {
     const double dt = update->dt;

@@ -211,8 +211,8 @@ def drag_script(mu_s=0.5, mu_k=0.45, pair_model="model hooke/stiffness tangentia
                   BODY=body, KT=kt, GAMMAT=gammat, DT=dt, V=v)
 
 
-REFUSED = ["tangential stick_slip cannot be combined with",
-           "it supports the combinations this LIGGGHTS builds with tangential history"]
+REFUSED = ["tangential stick_slip cannot be combined with model off (no normal model)",
+           "it takes Fn, kt and the tangential damping from the normal model"]
 RANGE = ["coefficientKineticFriction (mu_k)", "mu_s/2 <= mu_k <= mu_s", "[0.25, 0.5]",
          "coefficientFriction = 0.5"]
 MU_K_FORM = "fix             m6 all property/global coefficientKineticFriction {} 0.45"
@@ -228,15 +228,11 @@ BAD_CASES = {
                     ["coefficientKineticFriction has the wrong form", "peratomtypepair N"]),
     "mu_k_vector": (dict(mu_k_line=MU_K_FORM.format("peratomtype")),
                     ["coefficientKineticFriction has the wrong form", "peratomtypepair N"]),
-    # issue 16: the refused part and the command that asked for it
-    "pair_edinburgh": (dict(pair_model="model edinburgh tangential stick_slip", pair_settings=""),
-                       ["pair_style gran:", "model edinburgh (not built with tangential history"] + REFUSED),
-    "wall_luding": (dict(wall_model="model luding tangential stick_slip", wall_settings=""),
-                    ["fix floor wall/gran:", "model luding (not built with tangential history"] + REFUSED),
-    "pair_stiffness_capillary": (dict(pair_model="model hooke/stiffness tangential stick_slip cohesion "
-                                                 "easo/capillary/viscous"),
-                                 ["pair_style gran:", "the combination model hooke/stiffness, cohesion "
-                                  "easo/capillary/viscous, rolling_friction off, surface default"] + REFUSED),
+    # issue 16: the one combination that cannot work names the refused part and the command
+    "pair_without_normal_model": (dict(pair_model="tangential stick_slip", pair_settings=""),
+                                  ["pair_style gran:"] + REFUSED),
+    "wall_without_normal_model": (dict(wall_model="model off tangential stick_slip", wall_settings=""),
+                                  ["fix floor wall/gran:"] + REFUSED),
     # issue 15: a setting without its value at the end of the line (was SIGABRT / garbled text)
     "pair_trailing_setting": (dict(pair_settings="absolute_damping on limitForce on slip_reset_total"),
                               ["pair_style gran: setting 'slip_reset_total' at the end of the line has no value"]),
