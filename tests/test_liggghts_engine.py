@@ -363,3 +363,79 @@ def test_exact_timing_thousands_of_slips_per_step(tmp_path):
               f"{means[0]:.6f}, pyref {means[1]:.6f}, mu_k {mu_k} (standard error {se:.1e})")
         assert abs(means[0] - means[1]) <= 4 * np.sqrt(2) * se
         assert abs(means[0] - mu_k) <= 4 * se
+
+
+# ---------------------------------------------------------------- output (issue 15 section 4)
+
+@needs_liggghts
+def test_output_is_proportional_to_what_the_scene_records(tmp_path):
+    """A 600-disk pour (test_packing's) recording two grains, their contact, one wall contact
+    and the stats: the atoms dump holds the two grains only, the pair dump only contacts
+    between recorded grains, the stats one row per output step (reduced in LIGGGHTS); the
+    files grow with the rows recorded, not with the grains. The stats must be what the
+    adapter computed before from full dumps: the same run recording every grain gives the
+    kinetic energy (1/2 m v^2 + 1/2 I w^2, disks) from the grains' own columns to 1e-12
+    relative (summation order), and the contact count from the dumped positions exactly
+    (pairs and walls overlapping)."""
+    from test_packing import pour
+
+    sc = pour(30, 20, duration=0.02)
+    names = [g.name for g in sc.grains]
+    sc.output.every = 400
+    sc.output.stats = True
+    sc.output.grains = names[:2]
+    sc.output.contacts = [[names[0], names[1]], [names[0], sc.walls[0].name]]
+    small = liggghts_adapter.run(sc, tmp_path / "small").timeseries
+    work = tmp_path / "small" / "liggghts"
+    atoms = liggghts_adapter._read_dump(work / "atoms.dump")
+    assert all(len(f) == 2 for f in atoms.values())
+    pairs = liggghts_adapter._read_dump(work / "pairs.dump")
+    assert all(set(f[:, :2].astype(int).ravel()) <= {1, 2} for f in pairs.values() if len(f))
+    stats = liggghts_adapter._read_dump(work / "stats.dump")
+    assert sorted(stats) == sorted(atoms) and all(len(f) == 1 for f in stats.values())
+    size_small = sum(p.stat().st_size for p in work.glob("*.dump"))
+
+    sc.output.grains = names
+    full = liggghts_adapter.run(sc, tmp_path / "full").timeseries
+    size_full = sum(p.stat().st_size for p in (tmp_path / "full" / "liggghts").glob("*.dump"))
+    print(f"\n[output] {len(names)} grains, {len(small)} rows: dumps {size_small} bytes recording 2 grains, "
+          f"{size_full} bytes recording all")
+    assert size_small * 20 < size_full
+    for col in small.columns:
+        assert np.array_equal(small[col], full[col]), col
+    m = np.array([sc.grain_mass(g) for g in sc.grains])
+    inertia = np.array([sc.grain_inertia(g) for g in sc.grains])
+    r = np.array([g.radius for g in sc.grains])
+    v2 = np.array([full[f"{n}_vx"] ** 2 + full[f"{n}_vy"] ** 2 for n in names])
+    w2 = np.array([full[f"{n}_wz"] ** 2 for n in names])
+    ekin = 0.5 * (m[:, None] * v2).sum(axis=0) + 0.5 * (inertia[:, None] * w2).sum(axis=0)
+    assert np.allclose(full["ekin"], ekin, rtol=1e-12, atol=0)
+    for k in range(len(full)):
+        x = np.array([[full[f"{n}_x"][k], full[f"{n}_y"][k]] for n in names])
+        d = np.linalg.norm(x[:, None, :] - x[None, :, :], axis=2)
+        n_pairs = int(np.triu(d <= r[:, None] + r[None, :], 1).sum())
+        n_walls = sum(int((r - ((x - w.point[:2]) @ w.normal[:2]) > 0).sum()) for w in sc.walls)
+        assert full["n_contacts"][k] == n_pairs + n_walls, k
+
+
+@needs_liggghts
+def test_non_finite_output_fails_loudly(tmp_path):
+    """A run whose output holds a NaN or an infinity must not come back as a time series:
+    the adapter raises one clear error naming the column, time and step."""
+    sc = scene_mod.load("drag", duration=1e-4)
+    sc.output.every = 10
+    work = tmp_path / "liggghts"
+    work.mkdir()
+    script = liggghts_adapter._Script(sc, work)
+    liggghts_adapter.run(sc, tmp_path)  # a real run writes the dumps ...
+    text = (work / "atoms.dump").read_text().split("\n")
+    k = max(i for i, line in enumerate(text) if line.startswith("1 "))
+    fields = text[k].split()
+    fields[5] = "nan"  # ... then one velocity becomes NaN in the last row
+    text[k] = " ".join(fields)
+    (work / "atoms.dump").write_text("\n".join(text))
+    with pytest.raises(RuntimeError) as e:
+        liggghts_adapter._timeseries(script, work)
+    msg = str(e.value)
+    print(f"\n[non-finite] {msg}")
+    assert "non-finite" in msg and "grain_vy" in msg and "step 50" in msg and "\n" not in msg
