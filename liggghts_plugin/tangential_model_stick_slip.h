@@ -312,19 +312,15 @@ public:
     const bool energy = update_history && (heating || elasticpot || dissipated);
 
     double * const hist = &sidata.contact_history[history_offset];
-    if (update_history && stamp_offset >= 0) {
-      // a pair that did not touch at the previous pass is a new contact (see postSettings);
-      // the first pass of this model (after read_restart, a new pair_style) takes step - 1
-      double & touched = sidata.contact_history[stamp_offset];
-      const double previous = last_pass >= 0.0 ? last_pass : this_pass - 1.0;
-      if (touched != previous) {
-        hist[0] = hist[1] = hist[2] = 0.0;
-        if (record)
-          for (int k = 0; k < 5; k++) sidata.contact_history[record_offset + k] = 0.0;
-      }
-      touched = this_pass;
-    }
+    // a pair that did not touch at the previous pass is a new contact (see postSettings);
+    // the first pass of this model (after read_restart, a new pair_style) takes step - 1.
+    // (Only read here: the stamp is written with the history at the end, so that no store
+    // into the history comes before the law's arithmetic.)
+    bool fresh = false;
+    if (update_history && stamp_offset >= 0)
+      fresh = sidata.contact_history[stamp_offset] != (last_pass >= 0.0 ? last_pass : this_pass - 1.0);
     double D[3] = { hist[0], hist[1], hist[2] };
+    if (fresh) D[0] = D[1] = D[2] = 0.0;
     double D0[3];  // D turned into the tangent plane, before the increment (exact timing)
     const double spring_before = energy ? 0.5 * kt * StickSlip::dot(D, D) : 0.0;
     if (update_history) {
@@ -398,11 +394,12 @@ public:
 
     if (update_history) {
       for (int k = 0; k < 3; k++) hist[k] = D[k];
+      if (stamp_offset >= 0) sidata.contact_history[stamp_offset] = this_pass;
       if (record) {
         double * const rec = &sidata.contact_history[record_offset];
         rec[0] = fn;
         for (int k = 0; k < 3; k++) rec[1 + k] = F[k];
-        if (slip) rec[4] += 1.0;
+        rec[4] = (fresh ? 0.0 : rec[4]) + (slip ? 1.0 : 0.0);
       }
     }
 
