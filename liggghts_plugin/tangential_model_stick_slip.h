@@ -197,7 +197,7 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
 {
   double ** mu_s;
   double ** mu_k;
-  int history_offset;   // D: the spring elongation, 3 values (the same memory as `tangential history`)
+  int history_offset;   // D: the spring elongation, 3 values (the same values as `tangential history`)
   int record_offset;    // optional diagnostics: Fn, F_s (3), slip count
   int stamp_offset;     // pair contacts: the time step at which the contact last touched
   double this_pass, last_pass;  // time steps of this and of the previous pass that updated histories
@@ -205,7 +205,7 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
   bool record;
   bool exact;           // slips at their exact time inside the step (docs/law.md E0-E7)
   bool project;         // history_rotation project: stock history's rule (increment, then project)
-  bool keep_separated;  // history_on_separation keep: stock history's rule (see connectToProperties)
+  bool keep_separated;  // history_on_separation keep: stock history's rule (see postSettings)
   // LIGGGHTS' energy and heat bookkeeping, as for `tangential history`
   bool heating, heating_track, elasticpot, dissipated;
   int elastic_potential_offset;
@@ -215,7 +215,8 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
 public:
   TangentialModel(LAMMPS * lmp, IContactHistorySetup * hsetup, class ContactModelBase * c) :
     TangentialModelBase(lmp, hsetup, c), mu_s(NULL), mu_k(NULL), history_offset(-1), record_offset(-1),
-    stamp_offset(-1), this_pass(-1.0), last_pass(-1.0), reset_total(false), record(false), exact(false), project(false), keep_separated(false),
+    stamp_offset(-1), this_pass(-1.0), last_pass(-1.0), reset_total(false), record(false), exact(false),
+    project(false), keep_separated(false),
     heating(false), heating_track(false), elasticpot(false), dissipated(false),
     elastic_potential_offset(-1), fix_dissipated(NULL), cmb(c)
   {
@@ -231,7 +232,7 @@ public:
     settings.registerOnOff("stick_slip_record", record, false);
     settings.registerOnOff("exact_slip_timing", exact, false);
     // `history_rotation keep_length|project` and `history_on_separation drop|keep` are
-    // turned into these by the registration's settings check (register_stick_slip.cpp)
+    // turned into these by the settings check of the pair and wall styles (stick_slip_styles.h)
     settings.registerOnOff(StickSlip::ROTATION_PROJECT, project, false);
     settings.registerOnOff(StickSlip::SEPARATION_KEEP, keep_separated, false);
     // the stock model's options (tangential_model_history.h), same names
