@@ -183,7 +183,7 @@ namespace StickSlip {
         }
         const double n = std::floor(rest / L);
         const double part = rest - n * L;
-        const double shrink = std::pow(r, n);
+        const double shrink = n == 0.0 ? 1.0 : std::pow(r, n);  // (no whole cycle left: the common case)
         for (int k = 0; k < 3; k++) applied[k] = trial[k] = (low + rate * part) * u[k] + shrink * q[k];
         stick += rest;
         return;
