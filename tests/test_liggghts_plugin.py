@@ -635,15 +635,17 @@ def max_diff(x, y):
 
 
 def test_restart_continues_exactly(tmp_path):
-    """A restart file holds every atom's x, v, omega and every contact's history (pair
-    and wall, 8 values each with the record) as binary doubles. Reading it back, LIGGGHTS
+    """A restart file holds every atom's x, v, omega and every contact's history (with the
+    record: 9 values per pair, the last the step it last touched; 8 per wall contact) as
+    binary doubles. Reading it back, LIGGGHTS
     (1) rebuilds the neighbour lists, keeping the history of touching pairs only, and
     (2) recomputes the forces of step N from the stored history without updating it and
     with v(t) instead of v(t - dt/2). So N + restart + N equals 2N uninterrupted bit for
     bit when neither changes anything:
-    (1) the model zeroes the history of a pair as soon as it opens (contact distance
-        factor 1.01, see test_history_of_an_opened_pair_contact_is_dropped), so the
-        rebuild keeps exactly the histories that matter;
+    (1) a pair that opened has no history that matters: the model starts a pair afresh
+        when it did not touch at the previous step (its step stamp, which the restart
+        carries; see test_history_of_an_opened_pair_contact_is_dropped), and the rebuild
+        drops opened pairs anyway;
     (2) with no dashpots (gamman = gammat = 0) the recomputed force is the applied one: a
         sticking contact's force is -Ks D; after a slip the stored D = -F_s/Ks gives back
         |F| = Fmin < mu_s Fn, i.e. the same F_s (IEEE rounding reproduced it here; a 1-ulp
