@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 
-APT_PACKAGES="python3-venv python3-pip liggghts libliggghts-dev libopenmpi-dev openmpi-bin g++ cmake yade python3-numpy"
+APT_PACKAGES="python3-venv python3-pip liggghts libliggghts-dev liggghts-doc libopenmpi-dev openmpi-bin g++ cmake yade python3-numpy"
 
 setup_system() {
     local missing=()

@@ -1,112 +1,109 @@
 /* Registers `tangential stick_slip` with the installed LIGGGHTS library when this
-   shared object is loaded (static initializer): the model name, and one pair style
-   and one wall style per supported combination of normal and rolling model.
-   Every other combination with stick_slip is registered too, as a creator that stops
-   with an error listing the supported ones (the library would otherwise say only
-   "Unknown tangential model"). */
+   shared object is loaded (static initializer): the model name, and one pair style and
+   one wall style for every combination of surface, normal, cohesion and rolling model
+   that the library itself offers with stock `tangential history`. That list is read
+   from the library's symbols when the plugin is configured (CMakeLists.txt writes it to
+   stick_slip_combinations.h); the styles are compiled and registered in register_combinations.cpp.
+   Every other combination with stick_slip runs through LIGGGHTS' generic contact model,
+   as stock history's do (model off, which cannot work, stops with an error naming it and
+   the command that asked for it). */
 
-#include <mpi.h>
-#include "fix_insert_stream.h"  // must precede pair_gran_base.h (a stub header otherwise fails)
-#include "contact_models.h"
-#include "granular_pair_style.h"
-#include "granular_wall.h"
-#include "pair_gran_base.h"
-#include "fix_wall_gran_base.h"
-#include "error.h"
+#include "stick_slip_styles.h"
+#include <cstdio>
 #include <set>
-#include "tangential_model_stick_slip.h"
+#include <string>
 
 using namespace LIGGGHTS;
 using namespace LIGGGHTS::ContactModels;
 
 namespace {
 
-const char SUPPORTED[] =
-    "tangential stick_slip supports: model hooke, hooke/stiffness, hertz or hertz/stiffness; "
-    "rolling_friction off, cdt, epsd, epsd2 or epsd3; no cohesion model; the default surface model";
-
-template<int M, int R>
-struct Combination {
-  typedef GranStyle<M, TANGENTIAL_STICK_SLIP, COHESION_OFF, R, SURFACE_DEFAULT> Style;
-  typedef ContactModel<Style> Model;
-
-  static PairStyles::IGranularPairStyle * pair(LAMMPS * lmp, PairGran * parent, int64_t hash)
-  { return new PairStyles::Granular<Model>(lmp, parent, hash); }
-
-  static Walls::IGranularWall * wall(LAMMPS * lmp, FixWallGran * parent, int64_t hash)
-  { return new Walls::Granular<Model>(lmp, parent, hash); }
-
-  static void add(std::set<int64_t> & done)
-  {
-    const int64_t hash = Style::HASHCODE;  // a copy: the static member has no definition to bind to
-    PairStyles::Factory::instance().addStyle("gran", hash, &pair);
-    Walls::Factory::instance().addStyle("gran", hash, &wall);
-    done.insert(hash);
-  }
+// the model ids this LIGGGHTS knows (its installed model headers)
+const int NORMAL[] = {
+#define NORMAL_MODEL(CONST, NAME, ID) CONST,
+#include "style_normal_model.h"
+#undef NORMAL_MODEL
+};
+const int COHESION[] = {
+#define COHESION_MODEL(CONST, NAME, ID) CONST,
+#include "style_cohesion_model.h"
+#undef COHESION_MODEL
+};
+const int ROLLING[] = {
+#define ROLLING_MODEL(CONST, NAME, ID) CONST,
+#include "style_rolling_model.h"
+#undef ROLLING_MODEL
+};
+const int SURFACE[] = {
+#define SURFACE_MODEL(CONST, NAME, ID) CONST,
+#include "style_surface_model.h"
+#undef SURFACE_MODEL
 };
 
-PairStyles::IGranularPairStyle * unsupported_pair(LAMMPS * lmp, PairGran *, int64_t)
+struct Combo { int m, c, r, s; bool pair, wall; };
+
+// the library's own combinations with tangential history (generated at configure time)
+const Combo SUPPORTED[] = {
+#define STICK_SLIP_COMBINATION(M, C, R, S, PAIR, WALL) { M, C, R, S, PAIR, WALL },
+#include "stick_slip_combinations.h"
+#undef STICK_SLIP_COMBINATION
+};
+const size_t NSUPPORTED = sizeof SUPPORTED / sizeof *SUPPORTED;
+
+/* A combination the library has no compiled-in version of: LIGGGHTS runs those through its
+   generic contact model, which picks each part at run time (and warns that it is slower);
+   stock history does so for every combination outside its list. stick_slip does the same
+   with its own copy of the generic model (it knows stick_slip). The one combination that
+   cannot work is the one without a normal model: stick_slip takes Fn, Ks and nu_s from it. */
+typedef ContactModel<GranStyle<> > Generic;
+
+void refuse_without_normal_model(LAMMPS * lmp, const std::string & command)
 {
-  lmp->error->all(FLERR, SUPPORTED);
-  return NULL;
+  const std::string msg = command + ": tangential stick_slip cannot be combined with model off (no normal "
+      "model): it takes Fn, kt and the tangential damping from the normal model";
+  lmp->error->all(FLERR, msg.c_str());
 }
 
-Walls::IGranularWall * unsupported_wall(LAMMPS * lmp, FixWallGran *, int64_t)
+PairStyles::IGranularPairStyle * generic_pair(LAMMPS * lmp, PairGran * parent, int64_t hash)
 {
-  lmp->error->all(FLERR, SUPPORTED);
-  return NULL;
+  if ((hash & 63) == NORMAL_OFF) refuse_without_normal_model(lmp, "pair_style gran");
+  return new LIGGGHTS::StickSlip::PairStyle<Generic>(lmp, parent, hash);
 }
 
-template<int R>
-void add_normal_models(std::set<int64_t> & done)
+Walls::IGranularWall * generic_wall(LAMMPS * lmp, FixWallGran * parent, int64_t hash)
 {
-  Combination<HOOKE, R>::add(done);
-  Combination<HOOKE_STIFFNESS, R>::add(done);
-  Combination<HERTZ, R>::add(done);
-  Combination<HERTZ_STIFFNESS, R>::add(done);
+  if ((hash & 63) == NORMAL_OFF) refuse_without_normal_model(lmp, std::string("fix ") + parent->id + " " + parent->style);
+  return new LIGGGHTS::StickSlip::WallStyle<Generic>(lmp, parent, hash);
 }
 
 struct RegisterStickSlip {
   RegisterStickSlip()
   {
+    // LIGGGHTS stops on an error of one process with MPI_Abort, which drops what is still
+    // buffered: with stdout redirected to a file or pipe the ERROR line would be lost.
+    // Line buffering writes each line out at once (nothing has been printed yet here).
+    setvbuf(stdout, NULL, _IOLBF, BUFSIZ);
+
     Factory::instance().addTangentialModel("stick_slip", TANGENTIAL_STICK_SLIP);
+    // the supported combinations register themselves (register_combinations.cpp)
 
-    std::set<int64_t> supported;
-    add_normal_models<ROLLING_OFF>(supported);
-    add_normal_models<ROLLING_CDT>(supported);
-    add_normal_models<ROLLING_EPSD>(supported);
-    add_normal_models<ROLLING_EPSD2>(supported);
-    add_normal_models<ROLLING_EPSD3>(supported);
-
-    // every other combination with stick_slip stops with the list above
-    const int normal[] = { NORMAL_OFF,
-#define NORMAL_MODEL(ID, NAME, CONST) ID,
-#include "style_normal_model.h"
-#undef NORMAL_MODEL
-    };
-    const int cohesion[] = { COHESION_OFF,
-#define COHESION_MODEL(ID, NAME, CONST) ID,
-#include "style_cohesion_model.h"
-#undef COHESION_MODEL
-    };
-    const int rolling[] = { ROLLING_OFF,
-#define ROLLING_MODEL(ID, NAME, CONST) ID,
-#include "style_rolling_model.h"
-#undef ROLLING_MODEL
-    };
-    const int surface[] = {
-#define SURFACE_MODEL(ID, NAME, CONST) ID,
-#include "style_surface_model.h"
-#undef SURFACE_MODEL
-    };
-    for (size_t m = 0; m < sizeof normal / sizeof *normal; m++)
-      for (size_t c = 0; c < sizeof cohesion / sizeof *cohesion; c++)
-        for (size_t r = 0; r < sizeof rolling / sizeof *rolling; r++)
-          for (size_t s = 0; s < sizeof surface / sizeof *surface; s++) {
-            const int64_t hash = Utils::generate_gran_hashcode(normal[m], TANGENTIAL_STICK_SLIP, cohesion[c], rolling[r], surface[s]);
-            if (supported.count(hash)) continue;
-            PairStyles::Factory::instance().addStyle("gran", hash, &unsupported_pair);
-            Walls::Factory::instance().addStyle("gran", hash, &unsupported_wall);
+    std::set<int64_t> pair, wall;
+    for (size_t k = 0; k < NSUPPORTED; k++) {
+      const Combo & x = SUPPORTED[k];
+      const int64_t hash = Utils::generate_gran_hashcode(x.m, TANGENTIAL_STICK_SLIP, x.c, x.r, x.s);
+      if (x.pair) pair.insert(hash);
+      if (x.wall) wall.insert(hash);
+    }
+    // every other combination with stick_slip: the generic model (or an error, see above)
+    for (size_t m = 0; m <= sizeof NORMAL / sizeof *NORMAL; m++)
+      for (size_t c = 0; c <= sizeof COHESION / sizeof *COHESION; c++)
+        for (size_t r = 0; r <= sizeof ROLLING / sizeof *ROLLING; r++)
+          for (size_t s = 0; s < sizeof SURFACE / sizeof *SURFACE; s++) {
+            const int mid = m ? NORMAL[m - 1] : NORMAL_OFF, cid = c ? COHESION[c - 1] : COHESION_OFF,
+                      rid = r ? ROLLING[r - 1] : ROLLING_OFF;
+            const int64_t hash = Utils::generate_gran_hashcode(mid, TANGENTIAL_STICK_SLIP, cid, rid, SURFACE[s]);
+            if (!pair.count(hash)) PairStyles::Factory::instance().addStyle("gran", hash, &generic_pair);
+            if (!wall.count(hash)) Walls::Factory::instance().addStyle("gran", hash, &generic_wall);
           }
   }
 };

@@ -20,6 +20,9 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 #include "update.h"
 #include "error.h"
 #include "neighbor.h"
+#include "atom.h"
+#include "fix_property_atom.h"
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -34,10 +37,17 @@ namespace StickSlip {
   inline MatrixProperty * createKineticFriction(PropertyRegistry & registry, const char * caller, bool)
   {
     LAMMPS * lmp = registry.getLAMMPS();
-    if (!lmp->modify->find_fix_property(KINETIC, "property/global", "peratomtypepair", 0, 0, caller, false))
+    if (!lmp->modify->find_fix_property(KINETIC, "property/global", "peratomtypepair", 0, 0, caller, false)) {
+      // given, but not as a matrix (scalar, vector): say so, rather than that it is missing
+      if (lmp->modify->find_fix_property(KINETIC, "property/global", "scalar", 0, 0, caller, false) ||
+          lmp->modify->find_fix_property(KINETIC, "property/global", "vector", 0, 0, caller, false))
+        lmp->error->all(FLERR, "tangential stick_slip: coefficientKineticFriction has the wrong form: it must be "
+                               "peratomtypepair N followed by the N x N values mu_k(i,j), e.g. "
+                               "fix ID all property/global coefficientKineticFriction peratomtypepair 1 0.45");
       lmp->error->all(FLERR, "tangential stick_slip needs the kinetic friction coefficient: "
                              "fix ID all property/global coefficientKineticFriction peratomtypepair N "
                              "mu_k(1,1) ... with coefficientFriction/2 <= mu_k <= coefficientFriction");
+    }
     MatrixProperty * mu_k = MODEL_PARAMS::createPerTypePairProperty(registry, KINETIC, caller);
     MatrixProperty * mu_s = MODEL_PARAMS::createCoeffFrict(registry, caller, false);
     const int ntypes = registry.max_type();
@@ -60,6 +70,126 @@ namespace StickSlip {
     delete mu_s;
     return mu_k;
   }
+
+  // Exact slip timing (docs/law.md "Exact slip timing", E1-E7; pyref/laws.py _exact_slips is
+  // the reference, same branch order and constants). Slips are followed one by one until the
+  // force direction has settled along -V_s (its part across -V_s below SETTLED * mu_s Fn, so
+  // that it changes the slip level by less than round-off) or MAX_EXPLICIT_SLIPS slips have
+  // been followed in the step; the remaining slips of the step then have a closed form.
+  static const double SETTLED = 1e-8;
+  // internal on/off settings behind the keywords history_rotation and history_on_separation
+  static const char * const ROTATION_PROJECT = "stick_slip_history_project";
+  static const char * const SEPARATION_KEEP = "stick_slip_keep_separated";
+  static const int MAX_EXPLICIT_SLIPS = 100;
+
+  inline double dot(const double * a, const double * b) { return a[0]*b[0] + a[1]*b[1] + a[2]*b[2]; }
+
+  /* E6: mu_k = mu_s, the force stays on |F| = T and turns towards u. With phi the angle
+     between F and u, tan(phi/2) falls as exp(-rate*theta/T); over the rest of the step by
+     exp(-k_rest). F is replaced by the force at the end of the step. */
+  inline void plastic_flow(double * F, const double * u, double k_rest, double T)
+  {
+    const double f = dot(F, u);
+    double q[3];
+    for (int k = 0; k < 3; k++) q[k] = F[k] - f * u[k];
+    const double qn = std::sqrt(dot(q, q));
+    const double s = qn / (T + f) * std::exp(-k_rest);  // tan(phi/2) at the end (f > 0 here)
+    const double c = (1.0 - s * s) / (1.0 + s * s), sn = 2.0 * s / (1.0 + s * s);
+    for (int k = 0; k < 3; k++) F[k] = (T * c) * u[k] + (T * sn) * (qn > 0.0 ? q[k] / qn : 0.0);
+  }
+
+  /* One step of a contact in which at least one slip happens (eqs. 5, 7, 8 integrated over
+     the step). V_s and Fn are constant over the step, so the trial force F = -Ks D - nu_s V_s
+     moves along u = -V_s/|V_s| at `rate` = Ks |V_s| dt per unit of step fraction theta.
+     In: F0, the trial force at theta = 0 (D turned, not yet incremented). Out: the force at
+     the end of the step (the one applied, as in a step without slip), the trial force at
+     the end (spring + dashpot) and the share of the step spent sticking. */
+  // (kept out of line: it runs only in steps that slip, and inlined it would crowd the
+  // common sticking step's code)
+  inline __attribute__((noinline)) void exact_slips(const double * F0, const double * vs, double T, double fmin, double r,
+                          double kt, double gammat, double dt, bool reset_total, bool flow_law,
+                          double * applied, double * trial, double & stick)
+  {
+    const double speed = std::sqrt(dot(vs, vs));
+    double u[3];
+    for (int k = 0; k < 3; k++) u[k] = speed > 0.0 ? -vs[k] / speed : 0.0;
+    const double rate = kt * speed * dt;
+    // after a slip the trial force restarts from Fmin t + kept u (E3): the spring holds Fmin
+    // and the dashpot adds nu_s |V_s| (default reset), or both hold Fmin (slip_reset_total)
+    const double kept = reset_total ? 0.0 : gammat * speed;
+    stick = 0.0;
+    if (!(T > 0.0)) {  // E1: no normal force, no friction; the spring keeps what the reset leaves
+      for (int k = 0; k < 3; k++) { applied[k] = 0.0; trial[k] = kept * u[k]; }
+      return;
+    }
+    double F[3] = { F0[0], F0[1], F0[2] };
+    double theta = 0.0;
+    for (int slips = 0; ; ) {
+      // E2: the next slip, where |F + rate dtheta u| reaches T (the larger root); before the
+      // step's first slip the force may already be at or above T (Fn fell): slip at once
+      const double f = dot(F, u), F2 = dot(F, F);
+      double dtheta;
+      if (slips == 0 && F2 >= T * T) dtheta = 0.0;
+      else {
+        const double gap = std::max(std::sqrt(std::max(T * T - (F2 - f * f), 0.0)) - f, 0.0);
+        dtheta = rate > 0.0 ? gap / rate : INFINITY;
+      }
+      if (!(theta + dtheta <= 1.0)) {  // sticks to the end of the step
+        const double rest = 1.0 - theta;
+        for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];
+        stick += rest;
+        return;
+      }
+      double hit[3];
+      for (int k = 0; k < 3; k++) hit[k] = F[k] + (rate * dtheta) * u[k];
+      stick += dtheta;
+      theta += dtheta;
+      // E3: the slip; the force drops to Fmin along its direction t, the spring is reset (eq. 8)
+      const double hn = std::sqrt(dot(hit, hit));
+      double t[3];
+      for (int k = 0; k < 3; k++) t[k] = hit[k] / hn;
+      slips++;
+      for (int k = 0; k < 3; k++) F[k] = fmin * t[k] + kept * u[k];
+      const double rest = 1.0 - theta;
+      // E4: the restarted force is at or above T again: slips follow without end and turn t
+      // onto u, the contact slides at Fmin u for the rest of the step
+      if (kept > 0.0 && dot(F, F) >= T * T) {
+        for (int k = 0; k < 3; k++) { trial[k] = (fmin + kept) * u[k]; applied[k] = fmin * u[k]; }
+        return;
+      }
+      if (rate == 0.0) {  // E5: nothing moves, the force stays where the slip left it
+        for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
+        stick += rest;
+        return;
+      }
+      const double along = dot(t, u);
+      if (flow_law && along > 0.0) {  // E6: plastic flow on |F| = T
+        plastic_flow(F, u, rate * rest / T, T);
+        for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
+        return;
+      }
+      // E7: settled along u (or followed MAX_EXPLICIT_SLIPS times): the remaining slips of
+      // the step repeat one cycle (Fmin + kept) u -> T u, of length L in theta; the part q of
+      // the force across u shrinks by r at each slip
+      const double fu = dot(F, u);
+      double q[3];
+      for (int k = 0; k < 3; k++) q[k] = F[k] - fu * u[k];
+      if ((std::sqrt(dot(q, q)) <= SETTLED * T && along > 0.0) || slips >= MAX_EXPLICIT_SLIPS) {
+        const double low = fmin + kept;
+        const double L = (T - low) / rate;
+        if (!(L > 0.0)) {  // restarts at T: slides, as E4
+          for (int k = 0; k < 3; k++) { trial[k] = low * u[k]; applied[k] = fmin * u[k]; }
+          return;
+        }
+        const double n = std::floor(rest / L);
+        const double part = rest - n * L;
+        const double shrink = n == 0.0 ? 1.0 : std::pow(r, n);  // (no whole cycle left: the common case)
+        for (int k = 0; k < 3; k++) applied[k] = trial[k] = (low + rate * part) * u[k] + shrink * q[k];
+        stick += rest;
+        return;
+      }
+    }
+  }
 }
 
 template<>
@@ -67,15 +197,28 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
 {
   double ** mu_s;
   double ** mu_k;
-  int history_offset;   // D: the spring elongation, 3 values (the same memory as `tangential history`)
+  int history_offset;   // D: the spring elongation, 3 values (the same values as `tangential history`)
   int record_offset;    // optional diagnostics: Fn, F_s (3), slip count
+  int stamp_offset;     // pair contacts: the time step at which the contact last touched
+  double this_pass, last_pass;  // time steps of this and of the previous pass that updated histories
   bool reset_total;     // eq. 8: false = spring alone carries Fmin (paper), true = spring + dashpot
   bool record;
+  bool exact;           // slips at their exact time inside the step (docs/law.md E0-E7)
+  bool project;         // history_rotation project: stock history's rule (increment, then project)
+  bool keep_separated;  // history_on_separation keep: stock history's rule (see postSettings)
+  // LIGGGHTS' energy and heat bookkeeping, as for `tangential history`
+  bool heating, heating_track, elasticpot, dissipated;
+  int elastic_potential_offset;
+  FixPropertyAtom * fix_dissipated;
+  ContactModelBase * cmb;
 
 public:
   TangentialModel(LAMMPS * lmp, IContactHistorySetup * hsetup, class ContactModelBase * c) :
     TangentialModelBase(lmp, hsetup, c), mu_s(NULL), mu_k(NULL), history_offset(-1), record_offset(-1),
-    reset_total(false), record(false)
+    stamp_offset(-1), this_pass(-1.0), last_pass(-1.0), reset_total(false), record(false), exact(false),
+    project(false), keep_separated(false),
+    heating(false), heating_track(false), elasticpot(false), dissipated(false),
+    elastic_potential_offset(-1), fix_dissipated(NULL), cmb(c)
   {
     // "1": the value changes sign when the pair is seen from the other grain
     history_offset = hsetup->add_history_value("shearx", "1");
@@ -87,6 +230,16 @@ public:
   {
     settings.registerOnOff("slip_reset_total", reset_total, false);
     settings.registerOnOff("stick_slip_record", record, false);
+    settings.registerOnOff("exact_slip_timing", exact, false);
+    // `history_rotation keep_length|project` and `history_on_separation drop|keep` are
+    // turned into these by the settings check of the pair and wall styles (stick_slip_styles.h)
+    settings.registerOnOff(StickSlip::ROTATION_PROJECT, project, false);
+    settings.registerOnOff(StickSlip::SEPARATION_KEEP, keep_separated, false);
+    // the stock model's options (tangential_model_history.h), same names
+    settings.registerOnOff("heating_tangential_history", heating, false);
+    settings.registerOnOff("heating_tracking", heating_track, false);
+    settings.registerOnOff("computeElasticPotential", elasticpot, false);
+    settings.registerOnOff("computeDissipatedEnergy", dissipated, false);
   }
 
   inline void postSettings(IContactHistorySetup * hsetup, ContactModelBase *)
@@ -100,6 +253,32 @@ public:
       hsetup->add_history_value("stick_slip_fsz", "1");
       hsetup->add_history_value("stick_slip_nslip", "0");
     }
+    // docs/law.md step 3: D is dropped when a contact ends. Walls do it themselves (LIGGGHTS
+    // zeroes a wall contact's history once it is apart). A grain pair's history survives
+    // until the next neighbour-list rebuild (LIGGGHTS tells a model that a pair has opened
+    // only within contactDistanceFactor * (r_i + r_j), 1 by default), so each pair contact
+    // carries the step at which it last touched: one that did not touch at the previous
+    // pass is a new contact and starts from zero. (Raising contactDistanceFactor instead
+    // widens the neighbour cutoff, which changes the spatial sort of the atoms on each
+    // process and with it the order of force sums: results then depend on the number of
+    // processes where stock history's do not.)
+    // `history_on_separation keep` leaves the stale spring, as stock history does.
+    if (!keep_separated && !cmb->is_wall())
+      stamp_offset = hsetup->add_history_value("stick_slip_step", "0");
+    // as stock history: the normal model keeps the contact's elastic force, the surface
+    // model the per-atom dissipated_energy property
+    if (elasticpot) {
+      elastic_potential_offset = cmb->get_history_offset("elastic_potential_normal");
+      if (elastic_potential_offset == -1)
+        error->all(FLERR, "tangential stick_slip: computeElasticPotential needs a normal model that computes "
+                          "the elastic potential (model hooke, hooke/stiffness, hertz or hertz/stiffness)");
+    }
+    if (dissipated && !cmb->is_wall()) {
+      fix_dissipated = static_cast<FixPropertyAtom*>(modify->find_fix_property("dissipated_energy", "property/atom", "vector", 0, 0, "dissipated energy", false));
+      if (!fix_dissipated)
+        error->all(FLERR, "tangential stick_slip: computeDissipatedEnergy: the surface model did not create "
+                          "the per-atom property dissipated_energy");
+    }
   }
 
   inline void connectToProperties(PropertyRegistry & registry)
@@ -108,13 +287,12 @@ public:
     registry.registerProperty("coeffKineticFrict", &StickSlip::createKineticFriction);
     registry.connect("coeffFrict", mu_s, "tangential_model stick_slip");
     registry.connect("coeffKineticFrict", mu_k, "tangential_model stick_slip");
-    // docs/law.md step 3: D must be dropped when a contact opens. LIGGGHTS calls
-    // surfacesClose() only for pairs closer than contactDistanceFactor * (r_i + r_j)
-    // (1 by default, i.e. never for an opened pair, whose history would then survive
-    // until the next neighbour-list rebuild). 1.01, as LIGGGHTS' own hooke model uses
-    // for its elastic energy: a contact opens by |v_n| dt per step, far below 1 % of
-    // r_i + r_j at any stable time step, so every opening is seen.
-    neighbor->register_contact_dist_factor(1.01);
+    if ((elasticpot || dissipated) && cmb->is_wall()) {
+      // as stock history: LIGGGHTS-PUBLIC 3.8 has no wall energy bookkeeping to feed
+      error->warning(FLERR, "tangential stick_slip: computeElasticPotential/computeDissipatedEnergy are "
+                            "ignored for walls, as for tangential history");
+      elasticpot = dissipated = false;
+    }
   }
 
   inline void surfacesIntersect(const SurfacesIntersectData & sidata, ForceData & i_forces, ForceData & j_forces)
@@ -127,25 +305,51 @@ public:
     if (!(kt > 0.0))
       error->one(FLERR, "tangential stick_slip needs a tangential stiffness kt > 0 from the normal model "
                         "(e.g. model hooke/stiffness with kt > 0)");
-    const double fn = sidata.Fn > 0.0 ? sidata.Fn : 0.0;              // eq. 3, never tensile
+    // eq. 3: Fn as the host's normal (and cohesion) models give it; where the host allows a
+    // tensile Fn (limitForce off, adhesive models) the threshold uses |Fn| as LIGGGHTS'
+    // tangential history does
+    const double fn = std::fabs(sidata.Fn);
     const bool update_history = sidata.computeflag && sidata.shearupdate;
+    const bool energy = update_history && (heating || elasticpot || dissipated);
 
     double * const hist = &sidata.contact_history[history_offset];
+    // a pair that did not touch at the previous pass is a new contact (see postSettings);
+    // the first pass of this model (after read_restart, a new pair_style) takes step - 1.
+    // (Only read here: the stamp is written with the history at the end, so that no store
+    // into the history comes before the law's arithmetic.)
+    bool fresh = false;
+    if (update_history && stamp_offset >= 0)
+      fresh = sidata.contact_history[stamp_offset] != (last_pass >= 0.0 ? last_pass : this_pass - 1.0);
     double D[3] = { hist[0], hist[1], hist[2] };
+    if (fresh) D[0] = D[1] = D[2] = 0.0;
+    double D0[3];  // D turned into the tangent plane, before the increment (exact timing)
+    const double spring_before = energy ? 0.5 * kt * StickSlip::dot(D, D) : 0.0;
     if (update_history) {
-      // 3D form: turn D into the current tangent plane, keeping its length
-      const double dn = D[0]*en[0] + D[1]*en[1] + D[2]*en[2];
-      if (dn != 0.0) {
-        const double old2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
+      const double dt = update->dt;
+      if (project) {
+        // stock history: increment, then project onto the current tangent plane
+        for (int k = 0; k < 3; k++) D[k] += vs[k] * dt;
+        const double dn = StickSlip::dot(D, en);
         for (int k = 0; k < 3; k++) D[k] -= dn * en[k];
-        const double new2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
-        if (new2 > 0.0) {
-          const double scale = std::sqrt(old2 / new2);
-          for (int k = 0; k < 3; k++) D[k] *= scale;
+        // (exact timing: the increment is then taken as projected with D)
+        for (int k = 0; k < 3; k++) D0[k] = D[k] - vs[k] * dt;
+      } else {
+        // 3D form: turn D into the current tangent plane, keeping its length
+        const double dn = D[0]*en[0] + D[1]*en[1] + D[2]*en[2];
+        if (dn != 0.0) {
+          const double old2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
+          for (int k = 0; k < 3; k++) D[k] -= dn * en[k];
+          const double new2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
+          if (new2 > 0.0) {
+            const double scale = std::sqrt(old2 / new2);
+            for (int k = 0; k < 3; k++) D[k] *= scale;
+          }
+        }
+        for (int k = 0; k < 3; k++) {
+          D0[k] = D[k];
+          D[k] += vs[k] * dt;  // eq. 7
         }
       }
-      const double dt = update->dt;
-      for (int k = 0; k < 3; k++) D[k] += vs[k] * dt;  // eq. 7
     }
 
     // eq. 5: trial force = spring + dashpot
@@ -156,8 +360,30 @@ public:
     const double limit = ms * fn;
     // static threshold reached (Fn = 0 always slips); squared, so that a sticking step
     // (the common case) needs no square root
-    const bool slip = mag2 >= limit * limit;
-    if (slip) {
+    bool slip = mag2 >= limit * limit;
+    double stick = slip ? 0.0 : 1.0;  // share of the step spent sticking (energy: the dashpot's share)
+    if (exact) {
+      // E0: |F| moves on a line during the step and is convex in time, so the step has no
+      // slip iff it is below the threshold at both ends; then it is exactly the step above.
+      // A re-evaluation without history update (run setup, computes) is a step of length 0.
+      const double dt = update_history ? update->dt : 0.0;
+      if (!update_history)
+        for (int k = 0; k < 3; k++) D0[k] = D[k];
+      double F0[3];
+      for (int k = 0; k < 3; k++) F0[k] = -kt * D0[k] - gammat * vs[k];
+      slip = slip || StickSlip::dot(F0, F0) >= limit * limit;
+      if (slip) {
+        const double mk = mu_k[sidata.itype][sidata.jtype];
+        const double fmin = (2.0 * mk - ms) * fn;
+        const double r = (2.0 * mk - ms) / ms;  // Fmin/T, exactly 1 iff mu_k = mu_s
+        // E6 applies when nothing is added at the reset (slip_reset_total, or no dashpot)
+        const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);
+        double trial[3];
+        StickSlip::exact_slips(F0, vs, limit, fmin, r, kt, gammat, dt, reset_total, flow_law, F, trial, stick);
+        // the spring at the end holds the trial force less the dashpot (eq. 5)
+        for (int k = 0; k < 3; k++) D[k] = -(trial[k] + gammat * vs[k]) / kt;
+      }
+    } else if (slip) {
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) Fn along the trial force
       const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;
       const double scale = mag2 > 0.0 ? fmin / std::sqrt(mag2) : 0.0;
@@ -169,16 +395,19 @@ public:
 
     if (update_history) {
       for (int k = 0; k < 3; k++) hist[k] = D[k];
+      if (stamp_offset >= 0) sidata.contact_history[stamp_offset] = this_pass;
       if (record) {
         double * const rec = &sidata.contact_history[record_offset];
         rec[0] = fn;
         for (int k = 0; k < 3; k++) rec[1 + k] = F[k];
-        if (slip) rec[4] += 1.0;
+        rec[4] = (fresh ? 0.0 : rec[4]) + (slip ? 1.0 : 0.0);
       }
     }
 
     // torques from the lever arms r*n (cri, crj: distance from the centres to the contact)
     const double tor[3] = { en[1]*F[2] - en[2]*F[1], en[2]*F[0] - en[0]*F[2], en[0]*F[1] - en[1]*F[0] };
+    if (energy)
+      account_energy(sidata, F, D, vs, kt, gammat, spring_before, stick);
     if (sidata.is_wall) {
       const double a = sidata.area_ratio;
       for (int k = 0; k < 3; k++) {
@@ -191,6 +420,70 @@ public:
         j_forces.delta_F[k] -= F[k];
         i_forces.delta_torque[k] += -sidata.cri * tor[k];
         j_forces.delta_torque[k] += -sidata.crj * tor[k];
+      }
+    }
+  }
+
+  /* docs/law.md "Energy": the work the contact received this step, -F_s.V_s dt, less the
+     increase of the spring energy Ks|D|^2/2, was dissipated; of it the dashpot took
+     nu_s |V_s|^2 dt times the share of the step spent sticking, the slips the rest.
+     Reported the way stock history reports its own (tangential_model_history.h): power
+     into sidata.P_diss and the heat tallies (1 dashpot, 2 slips), the elastic force into
+     the normal model's elastic-potential history, the dissipative part of the force into
+     the per-atom dissipated_energy property; the energy itself is added to that
+     property's first value, "energy" (half to each grain of a pair). */
+  __attribute__((noinline)) void account_energy(const SurfacesIntersectData & sidata, const double * F, const double * D,
+                             const double * vs, double kt, double gammat, double spring_before, double stick)
+  {
+    const double dt = update->dt;
+    const double a = sidata.is_wall ? sidata.area_ratio : 1.0;
+    const double total = (-StickSlip::dot(F, vs) * dt - (0.5 * kt * StickSlip::dot(D, D) - spring_before)) * a;
+    const double dashpot = gammat * StickSlip::dot(vs, vs) * dt * stick * a;
+    const double slips = total - dashpot;
+    if (heating) {
+      sidata.P_diss += total / dt;
+      if (heating_track) {
+        if (sidata.is_wall) {
+          cmb->tally_pw(dashpot / dt, sidata.i, sidata.jtype, 1);
+          cmb->tally_pw(slips / dt, sidata.i, sidata.jtype, 2);
+        } else {
+          cmb->tally_pp(dashpot / dt, sidata.i, sidata.j, 1);
+          cmb->tally_pp(slips / dt, sidata.i, sidata.j, 2);
+        }
+      }
+    }
+    // the spring part of the applied force, and the rest (dashpot, slip)
+    double Fela[3], Fdiss[3];
+    for (int k = 0; k < 3; k++) {
+      Fela[k] = -kt * D[k];
+      Fdiss[k] = F[k] - Fela[k];
+    }
+    const double * const en = sidata.en;
+    const double tela[3] = { en[1]*Fela[2] - en[2]*Fela[1], en[2]*Fela[0] - en[0]*Fela[2], en[0]*Fela[1] - en[1]*Fela[0] };
+    const double tdis[3] = { en[1]*Fdiss[2] - en[2]*Fdiss[1], en[2]*Fdiss[0] - en[0]*Fdiss[2], en[0]*Fdiss[1] - en[1]*Fdiss[0] };
+    if (elasticpot) {
+      double * const ep = &sidata.contact_history[elastic_potential_offset];
+      for (int k = 0; k < 3; k++) {
+        ep[1 + k] -= Fela[k];
+        ep[4 + k] -= -sidata.cri * tela[k];
+        ep[7 + k] -= -sidata.crj * tela[k];
+      }
+    }
+    if (dissipated) {
+      double * const di = fix_dissipated->array_atom[sidata.i];
+      di[0] += 0.5 * total;
+      for (int k = 0; k < 3; k++) {
+        di[1 + k] += -Fdiss[k];
+        di[4 + k] += sidata.cri * tdis[k];
+      }
+      // with newton off a pair across processors is computed by both; each books its own grain
+      if (sidata.j < atom->nlocal) {
+        double * const dj = fix_dissipated->array_atom[sidata.j];
+        dj[0] += 0.5 * total;
+        for (int k = 0; k < 3; k++) {
+          dj[1 + k] -= -Fdiss[k];
+          dj[4 + k] += sidata.crj * tdis[k];
+        }
       }
     }
   }
@@ -208,7 +501,16 @@ public:
     }
   }
 
-  inline void beginPass(SurfacesIntersectData &, ForceData &, ForceData &) {}
+  inline void beginPass(SurfacesIntersectData & sidata, ForceData &, ForceData &)
+  {
+    // (called before each pass over the grain pairs; walls do not call it)
+    if (!(sidata.computeflag && sidata.shearupdate)) return;
+    const double step = static_cast<double>(update->ntimestep);
+    if (step != this_pass) {
+      last_pass = this_pass;
+      this_pass = step;
+    }
+  }
   inline void endPass(SurfacesIntersectData &, ForceData &, ForceData &) {}
 };
 

@@ -4,6 +4,9 @@ scene file can express, run through the LIGGGHTS and YADE adapters.
 Invariants checked on every step's row (every = 1): all values finite, |Fs| <= mu_s*Fn
 (1e-9 relative: the engines' records pass through text dumps with 17 digits, and the
 threshold test itself is exact), Fs = 0 where Fn = 0.
+
+"liggghts-exact" is the LIGGGHTS plugin with slips at their exact time in the step
+(`slip_timing = "exact"`, docs/law.md E0-E7): the same cases and invariants.
 """
 import math
 
@@ -13,21 +16,29 @@ import pytest
 from stickslip import adapters
 from test_stability import make
 
-ENGINES = ["liggghts", "yade"]
+ENGINES = ["liggghts", "liggghts-exact", "yade"]
 
 
 def engine_or_skip(name):
-    reason = adapters.get(name).available()
+    adapter = adapters.get(name.removesuffix("-exact"))
+    reason = adapter.available()
     if reason is not None:
         pytest.skip(f"{name}: {reason}")
-    return adapters.get(name)
+    return adapter
+
+
+def engine_run(engine, sc, tmp_path):
+    """Run a scene on an engine (an "-exact" engine runs it with exact slip timing)."""
+    if engine.endswith("-exact"):
+        sc.contact.slip_timing = "exact"
+    return engine_or_skip(engine).run(sc, tmp_path).timeseries
 
 
 def run_checked(engine, sc, tmp_path):
     sc.output.every = 1
     sc.output.grains = ["g"]
     sc.output.contacts = [["g", "floor"]]
-    df = engine_or_skip(engine).run(sc, tmp_path).timeseries
+    df = engine_run(engine, sc, tmp_path)
     assert np.isfinite(df.to_numpy(dtype=float)).all()
     fn, fs = df["g-floor_fn"].to_numpy(), df["g-floor_fs"].to_numpy()
     mu_s = sc.contact.mu_s
@@ -88,7 +99,7 @@ def test_grain_spinning_on_a_plane(engine, tmp_path):
     sc.output.every = 100  # the invariants below need the end state only
     sc.output.grains = ["g"]
     sc.output.contacts = [["g", "floor"]]
-    df = engine_or_skip(engine).run(sc, tmp_path).timeseries
+    df = engine_run(engine, sc, tmp_path)
     assert np.isfinite(df.to_numpy(dtype=float)).all()
     g = sc.grains[0]
     m, inertia, r = sc.grain_mass(g), sc.grain_inertia(g), g.radius
@@ -150,7 +161,7 @@ def sustained_slide(engine, tmp_path):
 
     sc = scene_mod.load("drag", duration=2e-6 * 1_000_000)
     sc.output.every = 13
-    df = engine_or_skip(engine).run(sc, tmp_path).timeseries
+    df = engine_run(engine, sc, tmp_path)
     df = df[df["t"] > 0]  # row 0, the initial state, has no contact force yet
     assert (df["grain-floor_fn"] > 0).all()
     ratio = (df["grain-floor_fs"] / df["grain-floor_fn"]).to_numpy()
@@ -163,6 +174,10 @@ def sustained_slide(engine, tmp_path):
 
 def test_sustained_slide_liggghts(tmp_path):
     sustained_slide("liggghts", tmp_path)  # ~10 s
+
+
+def test_sustained_slide_liggghts_exact(tmp_path):
+    sustained_slide("liggghts-exact", tmp_path)
 
 
 @pytest.mark.slow

@@ -5,7 +5,9 @@ effects the scene switches on), runs the plugin's launcher, and turns its dumps 
 the standard time series. Per-contact force and slip count come from the model's own
 record (`stick_slip_record on`: Fn, F_s and a slip counter kept in the contact history),
 because LIGGGHTS' contact computes re-evaluate contacts and would report, at a slip
-step, a force that was never applied.
+step, a force that was never applied. Only what [output] asks for is written (the
+recorded grains and their contacts; the stats reduced to two numbers per row inside
+LIGGGHTS), and a run whose output is not finite raises an error.
 """
 from __future__ import annotations
 
@@ -164,8 +166,9 @@ class _Script:
                 self.primitive[w.name] = fid
                 continue
             stl = self._mesh_file(w, half)
+            store = " store_force yes" if sc.output.stats else ""  # per-atom force: the stats' contact count
             self.add(f"fix mesh{k} all mesh/surface file {stl} type 1",
-                     f"fix {fid} all wall/gran {model} mesh n_meshes 1 meshes mesh{k} {settings}")
+                     f"fix {fid} all wall/gran {model} mesh n_meshes 1 meshes mesh{k}{store} {settings}")
             self.mesh[w.name] = fid
             if w.rotation is not None:
                 if np.any(w.velocity):
@@ -195,32 +198,76 @@ class _Script:
         self._output()
 
     def _output(self):
+        """Dumps of what the scene records, at its interval, and nothing else (issue 15
+        section 4): the grains named in [output] grains and in [output] contacts (one
+        group), the pair contacts among those grains, the mesh-wall contacts of those
+        grains; [output] stats (contacts touching, kinetic energy) are reduced inside
+        LIGGGHTS to two numbers per row."""
         sc = self.scene
         every = sc.output.every
-        cols = "id x y z vx vy vz omegax omegay omegaz"
-        for name, fid in self.primitive.items():
-            cols += "".join(f" f_history_{fid}[{k}]" for k in range(RECORD_FN, RECORD_NSLIP + 1))
-        self.add(f"dump atoms all custom {every} atoms.dump {cols}", "dump_modify atoms sort id",
-                 _full_precision("atoms", len(cols.split()), ints=1))
-        pair_contacts = [c for c in sc.output.contacts if c[1] in self.ids] or sc.output.stats
+        pair_contacts = [c for c in sc.output.contacts if c[1] in self.ids]
         mesh_contacts = {c[1] for c in sc.output.contacts if c[1] in self.mesh}
-        if sc.output.stats:
-            mesh_contacts |= set(self.mesh)
+        self.walls_of = sorted({c[1] for c in sc.output.contacts if c[1] in self.primitive},
+                               key=list(self.primitive).index)
+        names = set(sc.output.grains) | {a for a, _ in sc.output.contacts} | {b for _, b in pair_contacts}
+        # the rows of every dump: at least one grain, so that the steps are always written
+        self.recorded = sorted(self.ids[n] for n in names) or [1]
+        self.add("group rec id " + _id_ranges(self.recorded))
+        cols = "id x y z vx vy vz omegax omegay omegaz"
+        for name in self.walls_of:
+            cols += "".join(f" f_history_{self.primitive[name]}[{k}]" for k in range(RECORD_FN, RECORD_NSLIP + 1))
+        self.add(f"dump atoms rec custom {every} atoms.dump {cols}", "dump_modify atoms sort id",
+                 _full_precision("atoms", len(cols.split()), ints=1))
         local = f"c_{{0}}[1] c_{{0}}[2] c_{{0}}[3] " + " ".join(
             f"c_{{0}}[{3 + k}]" for k in range(RECORD_FN, RECORD_NSLIP + 1))
         if pair_contacts:
-            self.add("compute pairs all pair/gran/local id history",
+            # pair/gran/local keeps the pairs with both grains in its group
+            self.add("compute pairs rec pair/gran/local id history",
                      f"dump pairs all local {every} pairs.dump {local.format('pairs')}",
                      _full_precision("pairs", 8))
         if mesh_contacts:
             if len(mesh_contacts) > 1:
                 raise ValueError("LIGGGHTS records the contacts of one mesh (moving or oblique) wall only; "
                                  f"the scene needs {sorted(mesh_contacts)}")
-            self.add("compute walls all wall/gran/local id history",
+            self.add("compute walls rec wall/gran/local id history",
                      f"dump walls all local {every} walls.dump {local.format('walls')}",
                      _full_precision("walls", 8))
+        if sc.output.stats:
+            self._stats_output(every)
         self.add(f"thermo {max(1, sc.steps // 50)}", "thermo_style custom step atoms",
                  "thermo_modify norm no", f"run {sc.steps}")
+
+    def _stats_output(self, every):
+        """[output] stats, reduced in LIGGGHTS: contacts touching (grain pairs that overlap,
+        counted at both grains by compute contact/atom; grains overlapping a primitive
+        wall's plane; grains a mesh wall pushes) and the kinetic energy (spin with the
+        scene's inertia: disks in 2D, spheres in 3D). Written on grain 1's row of
+        stats.dump, one row per output step."""
+        sc = self.scene
+        self.add("compute sse_cc all contact/atom", "compute sse_pairs all reduce sum c_sse_cc",
+                 "compute sse_radius all property/atom radius")
+        terms = ["c_sse_pairs/2"]
+        for k, w in enumerate(sc.walls):
+            name = f"sse_w{k}"
+            if w.name in self.primitive:
+                n, p = w.normal / np.linalg.norm(w.normal), w.point
+                dist = "+".join(f"(({a}-{_fmt(p[j])})*{_fmt(n[j])})" for j, a in enumerate("xyz"))
+                self.add(f'variable {name} atom "(c_sse_radius-({dist}))>0"')
+            else:
+                f = f"f_force_{self.mesh[w.name]}"
+                self.add(f'variable {name} atom "({f}[1]*{f}[1]+{f}[2]*{f}[2]+{f}[3]*{f}[3])>0"')
+            self.add(f"compute {name} all reduce sum v_{name}")
+            terms.append(f"c_{name}")
+        inertia = 0.5 if sc.dimension == 2 else 0.4
+        spin = (f"+0.5*{inertia}*mass*c_sse_radius*c_sse_radius*(omegax*omegax+omegay*omegay+omegaz*omegaz)"
+                if sc.effects["rotation"] else "")
+        self.add(f'variable sse_e atom "0.5*mass*(vx*vx+vy*vy+vz*vz){spin}"',
+                 "compute sse_ke all reduce sum v_sse_e",
+                 f'variable sse_n equal "{"+".join(terms)}"', "variable sse_k equal c_sse_ke",
+                 "variable sse_an atom v_sse_n", "variable sse_ak atom v_sse_k",
+                 "group sse_one id 1",
+                 f"dump stats sse_one custom {every} stats.dump id v_sse_an v_sse_ak",
+                 _full_precision("stats", 3, ints=1))
 
     def text(self):
         return "\n".join(self.lines) + "\n"
@@ -251,36 +298,41 @@ def _timeseries(script, work):
     pairs = _read_dump(work / "pairs.dump") if (work / "pairs.dump").is_file() else {}
     walls = _read_dump(work / "walls.dump") if (work / "walls.dump").is_file() else {}
     steps = sorted(atoms)
+    # rows of the atoms dump: the recorded grains, sorted by id
+    row = {i: k for k, i in enumerate(script.recorded)}
+    for s in steps:
+        if len(atoms[s]) != len(row) or not np.array_equal(atoms[s][:, 0], script.recorded):
+            raise RuntimeError(f"LIGGGHTS: the dump at step {s} does not hold the recorded grains "
+                               f"(lost atoms?); see {work / 'screen.txt'}")
     cols = {"t": [s * sc.dt for s in steps]}
     for name in sc.output.grains:
-        i = script.ids[name] - 1
+        i = row[script.ids[name]]
         blk = np.array([atoms[s][i] for s in steps])
         # dump columns: id x y z vx vy vz omegax omegay omegaz
         spin = ([9] if d == 2 else [7, 8, 9]) if sc.effects["rotation"] else []
         picks = [1 + k for k in range(d)] + [4 + k for k in range(d)] + spin
         cols.update(zip(columns.grain(name, d, sc.effects["rotation"]), blk[:, picks].T))
-    prim_order = list(script.primitive)
     for a, b in sc.output.contacts:
         ia = script.ids[a]
         rec = np.zeros((len(steps), 5))  # fn, fs (3), cumulative slips
         for r, s in enumerate(steps):
             if b in script.primitive:
-                base = 10 + 5 * prim_order.index(b)
-                rec[r] = atoms[s][ia - 1][base:base + 5]
+                base = 10 + 5 * script.walls_of.index(b)
+                rec[r] = atoms[s][row[ia]][base:base + 5]
             else:
                 blk = pairs.get(s) if b in script.ids else walls.get(s)
                 if blk is None or not len(blk):
                     continue
                 if b in script.ids:
                     ib = script.ids[b]
-                    for row in blk:
-                        if {int(row[0]), int(row[1])} == {ia, ib}:
-                            sign = 1.0 if int(row[0]) == ia else -1.0  # the record is the force on the first grain
-                            rec[r] = [row[3], *(sign * row[4:7]), row[7]]
+                    for line in blk:
+                        if {int(line[0]), int(line[1])} == {ia, ib}:
+                            sign = 1.0 if int(line[0]) == ia else -1.0  # the record is the force on the first grain
+                            rec[r] = [line[3], *(sign * line[4:7]), line[7]]
                 else:  # a mesh wall: one row per touched triangle, summed
-                    for row in blk[blk[:, 2].astype(int) == ia]:
-                        rec[r, :4] += row[3:7]
-                        rec[r, 4] += row[7]
+                    for line in blk[blk[:, 2].astype(int) == ia]:
+                        rec[r, :4] += line[3:7]
+                        rec[r, 4] += line[7]
         # slips since the previous row; a counter that drops means the contact was remade
         count = rec[:, 4]
         slips = np.diff(count, prepend=0.0)
@@ -293,27 +345,26 @@ def _timeseries(script, work):
         rate = sc.rotation_rate(w) if w.rotation else 0.0
         cols[columns.wall(name)[0]] = [rate * sc.dt * min(s, nrot) for s in steps]
     if sc.output.stats:
-        cols.update(zip(columns.STATS, _stats(sc, atoms, pairs, walls, steps, len(prim_order))))
-    return pd.DataFrame(cols)
+        stats = _read_dump(work / "stats.dump")
+        cols.update(zip(columns.STATS, ([int(round(stats[s][0][1])) for s in steps],
+                                        [float(stats[s][0][2]) for s in steps])))
+    df = pd.DataFrame(cols)
+    bad = ~np.isfinite(df.to_numpy(dtype=float))
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise RuntimeError(f"LIGGGHTS produced non-finite values: {df.columns[c]} = {df.iat[r, c]} at t = "
+                           f"{df['t'].iat[r]:.6g} s (step {steps[r]}); the run is not usable (see {work / 'screen.txt'})")
+    return df
 
 
-def _stats(sc, atoms, pairs, walls, steps, n_primitive):
-    """Contacts touching (Fn > 0 in the model's record) and kinetic energy, per row."""
-    m = np.array([sc.grain_mass(g) for g in sc.grains])
-    inertia = np.array([sc.grain_inertia(g) for g in sc.grains])
-    count, ekin = [], []
-    for s in steps:
-        a = atoms[s]
-        n = sum(int((a[:, 10 + 5 * k] > 0).sum()) for k in range(n_primitive))
-        for blk in (pairs.get(s), walls.get(s)):
-            if blk is not None and len(blk):
-                n += int((blk[:, 3] > 0).sum())
-        e = 0.5 * np.sum(m * np.sum(a[:, 4:7] ** 2, axis=1))
-        if sc.effects["rotation"]:
-            e += 0.5 * np.sum(inertia * np.sum(a[:, 7:10] ** 2, axis=1))
-        count.append(n)
-        ekin.append(e)
-    return count, ekin
+def _id_ranges(ids):
+    """Atom ids as LIGGGHTS group ranges: 1 2 3 5 -> '1:3 5'."""
+    parts, start = [], ids[0]
+    for prev, cur in zip(ids, ids[1:] + [None]):
+        if cur != prev + 1:
+            parts.append(str(start) if start == prev else f"{start}:{prev}")
+            start = cur
+    return " ".join(parts)
 
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):

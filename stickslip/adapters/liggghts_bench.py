@@ -3,10 +3,11 @@
 All figures come from one call, measured side by side on the same 3D packing of
 20 800 settled spheres (created once, cached under build/liggghts_bench/):
 
-1. plugin overhead: the same input script with `tangential stick_slip` and with
-   LIGGGHTS' stock `tangential history` (hooke/stiffness, pair and floor), run
-   alternately by the plugin's launcher; time = LIGGGHTS' own "Loop time" of a
-   fixed number of steps after a short warm-up. Memory: history values per contact
+1. plugin overhead: the same input script with `tangential stick_slip` (slips tested at
+   the end of the step, and with `exact_slip_timing on`) and with LIGGGHTS' stock
+   `tangential history` (hooke/stiffness, pair and floor), run alternately by the
+   plugin's launcher; time = LIGGGHTS' own "Loop time" of a fixed number of steps after
+   a short warm-up. Memory: history values per contact
    (read from `compute pair/gran/local id history`'s column count) and the peak
    RSS of each run.
 2. MPI speed-up: the stick_slip script on 1 process (launcher) and on 2
@@ -19,7 +20,7 @@ timings need an otherwise idle machine: each run measures the CPU the rest of th
 machine used meanwhile (/proc/stat), a run disturbed by more than NOISY cores is
 re-run (within a budget of 2 x reps re-runs), and the worst remaining figure is a row.
 
-Cost on the 2-core reference machine: ~3.5 min for benchmark(3) with the packing cached,
+Cost on the 2-core reference machine: ~4.5 min for benchmark(3) with the packing cached,
 ~2 min more to make it (40 000 steps on 2 processes).
 
     python -m stickslip.adapters.liggghts_bench [--reps 3]
@@ -93,16 +94,16 @@ run {settle}
 write_data {out}
 """
 
-# The timed script: identical for both models but for ${tang}.
+# The timed script: identical for all configurations but for ${tang} and ${extra}.
 TIMED = HEADER + """\
 read_data {data}
 neighbor 0.0003 bin
 neigh_modify delay 0
 """ + MATERIAL + """\
-pair_style gran model hooke/stiffness tangential ${{tang}} absolute_damping on limitForce on
+pair_style gran model hooke/stiffness tangential ${{tang}} absolute_damping on limitForce on ${{extra}}
 pair_coeff * *
 timestep 5e-6
-fix floor all wall/gran model hooke/stiffness tangential ${{tang}} primitive type 1 zplane 0.0 absolute_damping on limitForce on
+fix floor all wall/gran model hooke/stiffness tangential ${{tang}} primitive type 1 zplane 0.0 absolute_damping on limitForce on ${{extra}}
 fix grav all gravity 9.81 vector 0 0 -1
 fix integr all nve/sphere
 compute c all contact/atom
@@ -139,6 +140,11 @@ compute pl all pair/gran/local id history
 dump d all local 1 {dump} {columns}
 run 1
 """
+
+# each configuration: the tangential model, and a setting appended to the pair and wall
+# lines (fix wall/gran takes the settings last; "limitForce on" repeats one already there)
+TANGENTIAL = {"history": ("history", "limitForce on"), "stick_slip": ("stick_slip", "limitForce on"),
+              "stick_slip_exact": ("stick_slip", "exact_slip_timing on")}
 
 NOISY = 0.1  # cores used by other processes during a run above which it is re-run (within a budget)
 LAST_RUNS = {}  # (tangential model, processes) -> the runs behind the last benchmark() figures
@@ -262,7 +268,8 @@ def _timed(data, tang, nproc, work):
     d = work / f"{tang}-np{nproc}"
     d.mkdir(exist_ok=True)
     (d / "in.timed").write_text(TIMED.format(data=data, warm=WARM, steps=STEPS))
-    cmd = [str(LAUNCHER), "-in", "in.timed", "-log", "none", "-var", "tang", tang]
+    model, extra = TANGENTIAL[tang]
+    cmd = [str(LAUNCHER), "-in", "in.timed", "-log", "none", "-var", "tang", model, "-var", "extra", extra]
     if nproc > 1:
         cmd = ["mpirun", "-np", str(nproc)] + cmd
     info = {}
@@ -286,7 +293,7 @@ def benchmark(reps=3):
     reps = max(1, int(reps))
     DISCARDED.clear()
     data = _packing()
-    configs = [("history", 1), ("stick_slip", 1), ("stick_slip", 2)]
+    configs = [("history", 1), ("stick_slip", 1), ("stick_slip", 2), ("stick_slip_exact", 1)]
     runs = {c: [] for c in configs}
     with tempfile.TemporaryDirectory(prefix="liggghts_bench-") as work:
         work = Path(work)
@@ -310,11 +317,12 @@ def benchmark(reps=3):
     def med(c, key):
         return statistics.median(x[key] for x in runs[c])
 
-    A, B, M = configs
+    A, B, M, E = configs
     n = runs[B][0]["atoms"]
     tag = f"{n} spheres, {STEPS} steps, median of {reps}"
     rows = []
-    for c, label in ((A, "stock tangential history"), (B, "tangential stick_slip")):
+    for c, label in ((A, "stock tangential history"), (B, "tangential stick_slip"),
+                     (E, "tangential stick_slip exact_slip_timing on")):
         t, k = med(c, "s_per_step"), med(c, "contacts")
         rows.append({"benchmark": "liggghts", "case": f"overhead: {label}, s per step (1 process; {tag})",
                      "contacts": round(k), "seconds_per_step": t, "contact_steps_per_s": k / t, "value": t})
@@ -324,6 +332,10 @@ def benchmark(reps=3):
                  "value": ratio})
     rows.append({"benchmark": "liggghts", "case": "overhead: median of the per-repetition ratios stick_slip / history",
                  "value": paired})
+    rows.append({"benchmark": "liggghts", "case": "overhead: wall-time ratio stick_slip exact_slip_timing on / history "
+                 "(target <= 1.05)", "value": med(E, "s_per_step") / med(A, "s_per_step")})
+    rows.append({"benchmark": "liggghts", "case": "overhead: median of the per-repetition ratios stick_slip exact / history",
+                 "value": statistics.median(e["s_per_step"] / a["s_per_step"] for a, e in zip(runs[A], runs[E]))})
     for key, label in (("history", "stock tangential history"), ("stick_slip", "tangential stick_slip"),
                        ("stick_slip_record", "stick_slip with stick_slip_record on")):
         rows.append({"benchmark": "liggghts", "case": f"memory: history values per contact, {label}",
@@ -394,7 +406,7 @@ def main(argv=None):
     print(_table(rows))
     print("\nruns (s per step, other processes' CPU in cores):")
     for (tang, nproc), got in LAST_RUNS.items():
-        print(f"  {tang:<11} np={nproc}: " + ", ".join(f"{x['s_per_step']:.5f} ({x['foreign_cores'] or 0:.2f})" for x in got))
+        print(f"  {tang:<16} np={nproc}: " + ", ".join(f"{x['s_per_step']:.5f} ({x['foreign_cores'] or 0:.2f})" for x in got))
     if DISCARDED:
         print(f"  re-run because the machine was busy: {len(DISCARDED)} run(s)")
     print(f"\n({time.perf_counter() - t0:.0f} s)")
