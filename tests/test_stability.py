@@ -3,7 +3,6 @@
 Invariants checked at every step: all values finite, |Fs| <= mu_s*Fn (the law never
 exceeds its static threshold; 1e-12 relative for round-off), Fs = 0 when Fn = 0.
 """
-import copy
 import math
 import tomllib
 
@@ -73,6 +72,26 @@ def make(dim=2, kn=1.2e7, ks=9.6e6, nu_n=41.38, nu_s=33.1, mu_s=0.5, mu_k=0.45, 
     if dt_factor is not None:  # set dt relative to the stability limit, bypassing the check
         sc.dt = dt_factor * sc.critical_dt()
     return sc
+
+
+def random_parameter_scene(rng, timing="step"):
+    """A dragged grain with random parameters drawn from `rng`: stiffness ratio ks/kn over
+    3 decades, damping ratios 0-1, a random friction pair, reset rule, 2D/3D, rotation,
+    speed 1e-5-1 m/s, dt 0.1-0.9 of the stability limit; resting 3x its static overlap deep."""
+    dim = int(rng.choice([2, 3]))
+    kn = 10 ** rng.uniform(4, 7)
+    ks = kn * 10 ** rng.uniform(-2, 1)
+    r = 0.005
+    m = 2600 * (math.pi * r**2 if dim == 2 else 4 / 3 * math.pi * r**3)
+    mu_s = rng.uniform(0.1, 1.0)
+    mu_k = rng.uniform(mu_s / 2, mu_s)
+    zeta_n, zeta_s = rng.uniform(0, 1, 2)
+    speed = 10 ** rng.uniform(-5, 0)
+    vel = [speed, 0.0] if dim == 2 else [speed, 0.0, 0.0]
+    return make(dim=dim, kn=kn, ks=ks, nu_n=zeta_n * 2 * math.sqrt(kn * m),
+                nu_s=zeta_s * 2 * math.sqrt(ks * m), mu_s=mu_s, mu_k=mu_k,
+                reset=str(rng.choice(["spring", "total"])), rotation=bool(rng.integers(2)),
+                vel=vel, height=r - 3 * m * 9.81 / kn, dt_factor=rng.uniform(0.1, 0.9), timing=timing)
 
 
 def run_checked(sc, steps=None, every_step=None):
@@ -256,20 +275,7 @@ def test_randomised_parameter_sets(timing):
     2D/3D, rotation, drag speed): at every step all finite and |Fs| <= mu_s*Fn."""
     rng = np.random.default_rng(20241122)
     for _ in range(60):
-        dim = int(rng.choice([2, 3]))
-        kn = 10 ** rng.uniform(4, 7)
-        ks = kn * 10 ** rng.uniform(-2, 1)
-        r = 0.005
-        m = 2600 * (math.pi * r**2 if dim == 2 else 4 / 3 * math.pi * r**3)
-        mu_s = rng.uniform(0.1, 1.0)
-        mu_k = rng.uniform(mu_s / 2, mu_s)
-        zeta_n, zeta_s = rng.uniform(0, 1, 2)
-        speed = 10 ** rng.uniform(-5, 0)
-        vel = [speed, 0.0] if dim == 2 else [speed, 0.0, 0.0]
-        sc = make(dim=dim, kn=kn, ks=ks, nu_n=zeta_n * 2 * math.sqrt(kn * m),
-                  nu_s=zeta_s * 2 * math.sqrt(ks * m), mu_s=mu_s, mu_k=mu_k,
-                  reset=str(rng.choice(["spring", "total"])), rotation=bool(rng.integers(2)),
-                  vel=vel, height=r - 3 * m * 9.81 / kn, dt_factor=rng.uniform(0.1, 0.9), timing=timing)
+        sc = random_parameter_scene(rng, timing=timing)
         run_checked(sc, steps=400)
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from stickslip import scene as scene_mod
-from test_stability import make
+from test_stability import make, random_parameter_scene
 from test_stability_engines import run_checked
 
 
@@ -51,20 +51,7 @@ def test_contact_opening_while_sliding_exact(tmp_path):
 def test_randomised_parameter_sets_exact(tmp_path):
     rng = np.random.default_rng(20261123)
     for k in range(6):
-        dim = int(rng.choice([2, 3]))
-        kn = 10 ** rng.uniform(4, 7)
-        ks = kn * 10 ** rng.uniform(-2, 1)
-        r = 0.005
-        m = 2600 * (math.pi * r**2 if dim == 2 else 4 / 3 * math.pi * r**3)
-        mu_s = rng.uniform(0.1, 1.0)
-        mu_k = rng.uniform(mu_s / 2, mu_s)
-        zeta_n, zeta_s = rng.uniform(0, 1, 2)
-        speed = 10 ** rng.uniform(-5, 0)
-        vel = [speed, 0.0] if dim == 2 else [speed, 0.0, 0.0]
-        sc = exact(make(dim=dim, kn=kn, ks=ks, nu_n=zeta_n * 2 * math.sqrt(kn * m),
-                        nu_s=zeta_s * 2 * math.sqrt(ks * m), mu_s=mu_s, mu_k=mu_k,
-                        reset=str(rng.choice(["spring", "total"])), rotation=bool(rng.integers(2)),
-                        vel=vel, height=r - 3 * m * 9.81 / kn, dt_factor=rng.uniform(0.1, 0.9)))
+        sc = exact(random_parameter_scene(rng))
         sc.duration = 400 * sc.dt
         run_checked("yade", sc, tmp_path / str(k))
 
