@@ -314,7 +314,7 @@ def write_pour_data(path, seed=3):
     64 fixed spheres (r = 2 mm, type 2, never integrated) in a 2 cm x 2 cm periodic box,
     with random velocities (0.3 m/s per component): they collide at once."""
     rng = np.random.default_rng(seed)
-    rows, vel = [], []
+    rows = []
     side = 0.02
     for i in range(8):
         for j in range(8):
@@ -385,8 +385,6 @@ def energy_run(tmp_path, tag, dt, steps, settings=""):
     assert len(mobile_ids) == n_mobile
     bed = first[first[:, 1] == 2]
     rad = first[:, 3]
-    idx = {int(i): k for k, i in enumerate(first[:, 0])}
-    mob = np.array([idx[i] for i in mobile_ids])
     side = 0.02
     # normal dissipation, step by step, as the normal model computed it: positions x_k,
     # velocities v_(k-1/2) = (x_k - x_(k-1))/dt (velocity Verlet), Fn = max(0, kn delta + gn v_n).

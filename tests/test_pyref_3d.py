@@ -2,7 +2,6 @@
 import tomllib
 
 import numpy as np
-import pytest
 
 from stickslip import scene as scene_mod
 from pyref import Simulation

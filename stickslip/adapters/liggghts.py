@@ -11,7 +11,6 @@ LIGGGHTS), and a run whose output is not finite raises an error.
 """
 from __future__ import annotations
 
-import math
 import re
 import shutil
 import subprocess
@@ -218,7 +217,7 @@ class _Script:
             cols += "".join(f" f_history_{self.primitive[name]}[{k}]" for k in range(RECORD_FN, RECORD_NSLIP + 1))
         self.add(f"dump atoms rec custom {every} atoms.dump {cols}", "dump_modify atoms sort id",
                  _full_precision("atoms", len(cols.split()), ints=1))
-        local = f"c_{{0}}[1] c_{{0}}[2] c_{{0}}[3] " + " ".join(
+        local = "c_{0}[1] c_{0}[2] c_{0}[3] " + " ".join(
             f"c_{{0}}[{3 + k}]" for k in range(RECORD_FN, RECORD_NSLIP + 1))
         if pair_contacts:
             # pair/gran/local keeps the pairs with both grains in its group
