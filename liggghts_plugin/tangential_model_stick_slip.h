@@ -122,6 +122,20 @@ namespace StickSlip {
       for (int k = 0; k < 3; k++) { applied[k] = 0.0; trial[k] = kept * u[k]; }
       return;
     }
+    // E4 at the step's start, the common case in dense flows (about 90 % of these calls in
+    // the benchmark pour): at theta = 0 the force is at or above T, and after the slip the
+    // dashpot alone keeps it there, |Fmin t0 + kept u| >= T with t0 = F0/|F0|. Expanded
+    // (kept = nu_s |V_s|, t0.u = -F0.V_s/(|F0| |V_s|)) it needs one square root and no
+    // division, a shorter chain of dependent operations than the loop below; the same
+    // test, up to round-off
+    const double F02 = dot(F0, F0);
+    if (kept > 0.0 && F02 >= T * T) {
+      const double f0 = std::sqrt(F02);
+      if ((fmin * fmin + gammat * gammat * dot(vs, vs) - T * T) * f0 - 2.0 * fmin * gammat * dot(F0, vs) >= 0.0) {
+        for (int k = 0; k < 3; k++) { trial[k] = (fmin + kept) * u[k]; applied[k] = fmin * u[k]; }
+        return;
+      }
+    }
     double F[3] = { F0[0], F0[1], F0[2] };
     double theta = 0.0;
     for (int slips = 0; ; ) {
