@@ -72,7 +72,8 @@ namespace StickSlip {
   }
 
   // Exact slip timing (docs/law.md "Exact slip timing", E1-E7; pyref/laws.py _exact_slips is
-  // the reference, same branch order and constants). Slips are followed one by one until the
+  // the reference, same branch order and constants, plus one shortcut for speed: E4 at the
+  // step's start is tested first, see exact_slips). Slips are followed one by one until the
   // force direction has settled along -V_s (its part across -V_s below SETTLED * mu_s Fn, so
   // that it changes the slip level by less than round-off) or MAX_EXPLICIT_SLIPS slips have
   // been followed in the step; the remaining slips of the step then have a closed form.
