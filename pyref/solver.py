@@ -13,13 +13,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .laws import normal_force, rotate_history, tangential_force
+from .laws import _dot, normal_force, rotate_history, tangential_force
 
 PAIR_BRUTE_FORCE_MAX = 64  # below this many grains, test every pair (no tree)
-
-
-def _dot(a, b):
-    return np.einsum("ij,ij->i", a, b)
 
 
 class Contacts(NamedTuple):

@@ -60,6 +60,7 @@ if os.path.realpath(os.path.dirname(os.path.dirname(_laws.__file__))) != os.path
     raise ImportError(f"stickslip_yade.py needs the law kernel of its own repository ({_REPO}/pyref/laws.py), "
                       f"but `pyref` was already imported from {os.path.dirname(_laws.__file__)}")
 LawParams, rotate_history, tangential_force = _laws.LawParams, _laws.rotate_history, _laws.tangential_force
+_dot = _laws._dot  # row-wise dot products of (K, 3) arrays
 RESETS, SLIP_TIMINGS = _laws.RESETS, _laws.SLIP_TIMINGS
 
 
@@ -126,10 +127,6 @@ BO1 = {"Sphere": "Bo1_Sphere_Aabb", "Facet": "Bo1_Facet_Aabb", "Wall": "Bo1_Wall
 IG2 = {"Ig2_Sphere_Sphere_ScGeom": "Sphere", "Ig2_Sphere_Sphere_ScGeom6D": "Sphere",
        "Ig2_Facet_Sphere_ScGeom": "Facet", "Ig2_Facet_Sphere_ScGeom6D": "Facet",
        "Ig2_Wall_Sphere_ScGeom": "Wall", "Ig2_Box_Sphere_ScGeom": "Box", "Ig2_Box_Sphere_ScGeom6D": "Box"}
-
-
-def _dot(a, b):
-    return np.einsum("ij,ij->i", a, b)
 
 
 def _rows(vectors):
