@@ -73,7 +73,7 @@ namespace StickSlip {
 
   // Exact slip timing (docs/law.md "Exact slip timing", E1-E7; pyref/laws.py _exact_slips is
   // the reference, same branch order and constants, plus one shortcut for speed: E4 at the
-  // step's start is tested first, see exact_slips). Slips are followed one by one until the
+  // step's start is tested first, by the caller, surfacesIntersect). Slips are followed one by one until the
   // force direction has settled along -V_s (its part across -V_s below SETTLED * mu_s Fn, so
   // that it changes the slip level by less than round-off) or MAX_EXPLICIT_SLIPS slips have
   // been followed in the step; the remaining slips of the step then have a closed form.
@@ -122,20 +122,6 @@ namespace StickSlip {
     if (!(T > 0.0)) {  // E1: no normal force, no friction; the spring keeps what the reset leaves
       for (int k = 0; k < 3; k++) { applied[k] = 0.0; trial[k] = kept * u[k]; }
       return;
-    }
-    // E4 at the step's start, the common case in dense flows (about 90 % of these calls in
-    // the benchmark pour): at theta = 0 the force is at or above T, and after the slip the
-    // dashpot alone keeps it there, |Fmin t0 + kept u| >= T with t0 = F0/|F0|. Expanded
-    // (kept = nu_s |V_s|, t0.u = -F0.V_s/(|F0| |V_s|)) it needs one square root and no
-    // division, a shorter chain of dependent operations than the loop below; the same
-    // test, up to round-off
-    const double F02 = dot(F0, F0);
-    if (kept > 0.0 && F02 >= T * T) {
-      const double f0 = std::sqrt(F02);
-      if ((fmin * fmin + gammat * gammat * dot(vs, vs) - T * T) * f0 - 2.0 * fmin * gammat * dot(F0, vs) >= 0.0) {
-        for (int k = 0; k < 3; k++) { trial[k] = (fmin + kept) * u[k]; applied[k] = fmin * u[k]; }
-        return;
-      }
     }
     double F[3] = { F0[0], F0[1], F0[2] };
     double theta = 0.0;
@@ -386,13 +372,30 @@ public:
       // the trial force at the step's start: the spring before the increment V_s dt
       const double ktdt = kt * dt;
       const double F00 = F[0] + ktdt * vs[0], F01 = F[1] + ktdt * vs[1], F02 = F[2] + ktdt * vs[2];
-      slip = slip || F00*F00 + F01*F01 + F02*F02 >= limit * limit;
-      if (slip) {
+      const double start2 = F00*F00 + F01*F01 + F02*F02;
+      slip = slip || start2 >= limit * limit;
+      const double mk = mu_k[sidata.itype][sidata.jtype];
+      const double fmin = (2.0 * mk - ms) * fn;
+      const double vs2 = vs[0]*vs[0] + vs[1]*vs[1] + vs[2]*vs[2];
+      if (slip && start2 >= limit * limit && limit > 0.0 && !reset_total && gammat * gammat * vs2 > 0.0 &&
+          (fmin * fmin + gammat * gammat * vs2 - limit * limit) * std::sqrt(start2)
+            - 2.0 * fmin * gammat * (F00 * vs[0] + F01 * vs[1] + F02 * vs[2]) >= 0.0) {
+        // E4 at the step's start, the common slipping case in dense flows (over 90 % of them in
+        // the benchmark pour), tested here first: the force is at or above T at theta = 0
+        // and after the slip the dashpot alone keeps it there, |Fmin t0 + nu_s |V_s| u| >= T
+        // with t0 = F0/|F0|, u = -V_s/|V_s| (expanded: one square root, no division). The
+        // contact slides at Fmin u all step; the spring holds the trial force (Fmin +
+        // nu_s |V_s|) u less the dashpot, i.e. Fmin u (eq. 5).
+        const double c = fmin / std::sqrt(vs2), ck = c / kt;
+        for (int k = 0; k < 3; k++) {
+          F[k] = -c * vs[k];
+          D[k] = ck * vs[k];
+        }
+        stick = 0.0;
+      } else if (slip) {
         // (exact_slips works on copies: an array whose address is passed on lives in
         // memory for the whole function, and F, vs are on the path every contact takes)
         const double F0[3] = { F00, F01, F02 }, v[3] = { vs[0], vs[1], vs[2] };
-        const double mk = mu_k[sidata.itype][sidata.jtype];
-        const double fmin = (2.0 * mk - ms) * fn;
         const double r = (2.0 * mk - ms) / ms;  // Fmin/T, exactly 1 iff mu_k = mu_s
         // E6 applies when nothing is added at the reset (slip_reset_total, or no dashpot)
         const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);
@@ -428,8 +431,7 @@ public:
 
     // torques from the lever arms r*n (cri, crj: distance from the centres to the contact)
     const double tor[3] = { en[1]*F[2] - en[2]*F[1], en[2]*F[0] - en[0]*F[2], en[0]*F[1] - en[1]*F[0] };
-    if (energy)
-    {
+    if (energy) {
       const double Fc[3] = { F[0], F[1], F[2] }, Dc[3] = { D[0], D[1], D[2] }, vc[3] = { vs[0], vs[1], vs[2] };
       account_energy(sidata, Fc, Dc, vc, kt, gammat, spring_before, stick);  // (copies: as exact_slips)
     }
