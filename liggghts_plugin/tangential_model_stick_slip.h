@@ -72,8 +72,8 @@ namespace StickSlip {
   }
 
   // Exact slip timing (docs/law.md "Exact slip timing", E1-E7; pyref/laws.py _exact_slips is
-  // the reference, same branch order and constants, plus one shortcut for speed: E4 at the
-  // step's start is tested first, by the caller, surfacesIntersect). Slips are followed one by one until the
+  // the reference, same branch order and constants; for speed, E4 at the step's start is
+  // tested first, by the caller, surfacesIntersect). Slips are followed one by one until the
   // force direction has settled along -V_s (its part across -V_s below SETTLED * mu_s Fn, so
   // that it changes the slip level by less than round-off) or MAX_EXPLICIT_SLIPS slips have
   // been followed in the step; the remaining slips of the step then have a closed form.
@@ -331,7 +331,7 @@ public:
         for (int k = 0; k < 3; k++) D[k] += vs[k] * dt;
         const double dn = StickSlip::dot(D, en);
         for (int k = 0; k < 3; k++) D[k] -= dn * en[k];
-        // (exact timing: the increment is then taken as projected with D)
+        // (exact timing: the step starts from D - V_s dt, the increment projected with D)
       } else {
         // 3D form: turn D into the current tangent plane, keeping its length (docs/law.md
         // step 3): D <- (D - dn n) * sqrt(old2/new2) with new2 = old2 (1 - x), x = dn^2/old2
@@ -373,39 +373,42 @@ public:
       const double ktdt = kt * dt;
       const double F00 = F[0] + ktdt * vs[0], F01 = F[1] + ktdt * vs[1], F02 = F[2] + ktdt * vs[2];
       const double start2 = F00*F00 + F01*F01 + F02*F02;
-      slip = slip || start2 >= limit * limit;
-      const double mk = mu_k[sidata.itype][sidata.jtype];
-      const double fmin = (2.0 * mk - ms) * fn;
-      const double vs2 = vs[0]*vs[0] + vs[1]*vs[1] + vs[2]*vs[2];
-      if (slip && start2 >= limit * limit && limit > 0.0 && !reset_total && gammat * gammat * vs2 > 0.0 &&
-          (fmin * fmin + gammat * gammat * vs2 - limit * limit) * std::sqrt(start2)
-            - 2.0 * fmin * gammat * (F00 * vs[0] + F01 * vs[1] + F02 * vs[2]) >= 0.0) {
-        // E4 at the step's start, the common slipping case in dense flows (over 90 % of them in
-        // the benchmark pour), tested here first: the force is at or above T at theta = 0
-        // and after the slip the dashpot alone keeps it there, |Fmin t0 + nu_s |V_s| u| >= T
-        // with t0 = F0/|F0|, u = -V_s/|V_s| (expanded: one square root, no division). The
-        // contact slides at Fmin u all step; the spring holds the trial force (Fmin +
-        // nu_s |V_s|) u less the dashpot, i.e. Fmin u (eq. 5).
-        const double c = fmin / std::sqrt(vs2), ck = c / kt;
-        for (int k = 0; k < 3; k++) {
-          F[k] = -c * vs[k];
-          D[k] = ck * vs[k];
-        }
-        stick = 0.0;
-      } else if (slip) {
-        // (exact_slips works on copies: an array whose address is passed on lives in
-        // memory for the whole function, and F, vs are on the path every contact takes)
-        const double F0[3] = { F00, F01, F02 }, v[3] = { vs[0], vs[1], vs[2] };
-        const double r = (2.0 * mk - ms) / ms;  // Fmin/T, exactly 1 iff mu_k = mu_s
-        // E6 applies when nothing is added at the reset (slip_reset_total, or no dashpot)
-        const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);
-        double applied[3], trial[3], stuck;
-        StickSlip::exact_slips(F0, v, limit, fmin, r, kt, gammat, dt, reset_total, flow_law, applied, trial, stuck);
-        stick = stuck;
-        // the spring at the end holds the trial force less the dashpot (eq. 5)
-        for (int k = 0; k < 3; k++) {
-          F[k] = applied[k];
-          D[k] = -(trial[k] + gammat * vs[k]) / kt;
+      const bool start_over = start2 >= limit * limit;
+      slip = slip || start_over;
+      if (slip) {
+        const double mk = mu_k[sidata.itype][sidata.jtype];
+        const double fmin = (2.0 * mk - ms) * fn;
+        const double vs2 = StickSlip::dot(vs, vs);
+        if (start_over && limit > 0.0 && !reset_total && gammat * gammat * vs2 > 0.0 &&
+            (fmin * fmin + gammat * gammat * vs2 - limit * limit) * std::sqrt(start2)
+              - 2.0 * fmin * gammat * (F00 * vs[0] + F01 * vs[1] + F02 * vs[2]) >= 0.0) {
+          // E4 at the step's start, the common slipping case in dense flows (over 90 % of them
+          // in the benchmark pour), tested here first: the force is at or above T at theta = 0
+          // and after the slip the dashpot alone keeps it there, |Fmin t0 + nu_s |V_s| u| >= T
+          // with t0 = F0/|F0|, u = -V_s/|V_s| (expanded: one square root, no division). The
+          // contact slides at Fmin u all step; the spring holds the trial force (Fmin +
+          // nu_s |V_s|) u less the dashpot, i.e. Fmin u (eq. 5).
+          const double c = fmin / std::sqrt(vs2), ck = c / kt;
+          for (int k = 0; k < 3; k++) {
+            F[k] = -c * vs[k];
+            D[k] = ck * vs[k];
+          }
+          stick = 0.0;
+        } else {
+          // (exact_slips works on copies: an array whose address is passed on lives in
+          // memory for the whole function, and F, vs are on the path every contact takes)
+          const double F0[3] = { F00, F01, F02 }, v[3] = { vs[0], vs[1], vs[2] };
+          const double r = (2.0 * mk - ms) / ms;  // Fmin/T, exactly 1 iff mu_k = mu_s
+          // E6 applies when nothing is added at the reset (slip_reset_total, or no dashpot)
+          const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);
+          double applied[3], trial[3], stuck;
+          StickSlip::exact_slips(F0, v, limit, fmin, r, kt, gammat, dt, reset_total, flow_law, applied, trial, stuck);
+          stick = stuck;
+          // the spring at the end holds the trial force less the dashpot (eq. 5)
+          for (int k = 0; k < 3; k++) {
+            F[k] = applied[k];
+            D[k] = -(trial[k] + gammat * vs[k]) / kt;
+          }
         }
       }
     } else if (slip) {
