@@ -46,6 +46,7 @@ class Recording(NamedTuple):
     energy: dict | None  # name -> (R,) with output.energy (ENERGY_FIELDS)
     steps: int
     wall_time_s: float
+    slip_stats: np.ndarray | None = None  # (R, 4) with output.slip_stats (columns.SLIP_STATS)
 
 
 # Energy books (output.energy): kinetic, elastic (normal + tangential springs),
@@ -78,9 +79,16 @@ class Simulation:
         for i, q in enumerate(g):
             for a in q.imposed:
                 self.imposed[i, "xyz".index(a)] = True
+        # fixed grains: every velocity component held at zero, and the spin too
+        self.fixed = np.array([q.fixed for q in g], bool)
+        self.any_fixed = bool(self.fixed.any())
+        self.v[self.fixed] = 0.0
+        self.w[self.fixed] = 0.0
+        self.imposed[self.fixed] = True
         self.v_imposed = self.v.copy()
         self.any_imposed = bool(self.imposed.any())
         self.g = s.gravity if self.gravity_on else np.zeros(3)
+        self.turning_gravity = self.gravity_on and bool(s.gravity_rate or s.gravity_spinup[1])
 
         self.walls = s.walls
         self.W = len(s.walls)
@@ -108,6 +116,8 @@ class Simulation:
         self.names = {q.name: i for i, q in enumerate(g)}
         self.names.update({w.name: self.N + k for k, w in enumerate(s.walls)})
         self.slip_steps = 0
+        self.slip_stats = s.output.slip_stats  # output.slip_stats: |V_s| of each contact kept
+        self.vs_mag = np.zeros(0)
         self.record = record
         self._setup_recording()
         # Setup forces: no time has passed, so no spring increment (as LIGGGHTS' setup).
@@ -217,9 +227,13 @@ class Simulation:
         # Relative velocity of i's contact point with respect to j's (docs/law.md step 1).
         v_rel = self.v[i] - v_j
         if self.rotation_on:
-            # w_i x (r_i n) + w_j x (r_j n) = (r_i w_i + r_j w_j) x n: both lever arms lie along n.
+            # Lever arms from each centre to the contact point, taken midway in the overlap
+            # (c = r - delta/2, as LIGGGHTS and YADE place it; a wall has none):
+            # w_i x (c_i n) + w_j x (c_j n) = (c_i w_i + c_j w_j) x n, both along n.
+            c_i = self.r[i] - 0.5 * delta
+            c_j = np.where(grain_j, r_j - 0.5 * delta, 0.0)
             w_j = np.where(grain_j[:, None], self.w[np.minimum(j, N - 1)], 0.0)
-            v_rel = v_rel + _cross(self.r[i][:, None] * self.w[i] + r_j[:, None] * w_j, n)
+            v_rel = v_rel + _cross(c_i[:, None] * self.w[i] + c_j[:, None] * w_j, n)
         v_n = _dot(v_rel, n)
         V_s = v_rel - v_n[:, None] * n  # eq. 6
         fn = normal_force(delta, v_n, self.p)  # eq. 3
@@ -240,6 +254,8 @@ class Simulation:
                 D[old] = rotate_history(self.D[order[pos[old]]], n[old])
         tan = tangential_force(D, V_s, fn, dt, self.p, energy=self.energy)
         F_s, D, slipped = tan.force, tan.spring, tan.slipped
+        if self.slip_stats:
+            self.vs_mag = np.sqrt(_dot(V_s, V_s))
 
         if self.energy and len(key):
             self._account_contact_energy(fn, delta, v_n, tan, dt)
@@ -254,13 +270,26 @@ class Simulation:
         f = _scatter(np.concatenate((i, jg)), np.concatenate((F, -F[grain_j])), N)
         torque = None
         if self.rotation_on:
-            # Torques (r_i n) x F_s on i and (-r_j n) x (-F_s) = r_j (n x F_s) on j.
+            # Torques (c_i n) x F_s on i and (-c_j n) x (-F_s) = c_j (n x F_s) on j.
             c = _cross(n, F_s)
             torque = _scatter(np.concatenate((i, jg)),
-                              np.concatenate((self.r[i][:, None] * c, r_j[grain_j][:, None] * c[grain_j])), N)
+                              np.concatenate((c_i[:, None] * c, c_j[grain_j][:, None] * c[grain_j])), N)
         if self.gravity_on:
+            if self.turning_gravity:  # the gravity of the time the positions belong to
+                self.g = self.scene.gravity_at(self.step_no * self.dt)
             f += self.m[:, None] * self.g
         return f, torque
+
+    def slip_statistics(self):
+        """The row's columns.SLIP_STATS over grain-grain contacts (docs in columns.py)."""
+        c, p = self.contacts, self.p
+        sel = c.slipped & (c.j < self.N)
+        fn, vs = c.fn[sel], self.vs_mag[sel]
+        drop = 2.0 * (p.mu_s - p.mu_k) * fn  # the force a stick phase must climb after a slip
+        above_vd = vs * p.nu_s >= drop  # |V_s| >= V_d, written without dividing by nu_s = 0
+        above_vstar = vs * (p.nu_s + p.ks * self.dt) >= drop
+        ratio = np.sqrt(_dot(c.force[sel], c.force[sel])) / np.where(fn > 0, fn, np.inf)
+        return (int(sel.sum()), int(above_vd.sum()), int(above_vstar.sum()), float(ratio.sum()))
 
     def _account_contact_energy(self, fn, delta, v_n, tan, dt):
         """Energy each contact took out this step. Normal: the non-elastic part of the
@@ -289,6 +318,8 @@ class Simulation:
             w_half = self.w + 0.5 * dt * self.torque / self.inertia[:, None]
             if self.dim == 2:
                 w_half[:, :2] = 0.0
+            if self.any_fixed:
+                w_half[self.fixed] = 0.0
         f_old = self.f
         self.v = v_half
         if self.rotation_on:
@@ -304,6 +335,8 @@ class Simulation:
             self.w = w_half + 0.5 * dt * self.torque / self.inertia[:, None]
             if self.dim == 2:
                 self.w[:, :2] = 0.0
+            if self.any_fixed:
+                self.w[self.fixed] = 0.0
         if self.energy:
             dx = self.x - x_old
             if self.gravity_on:
@@ -386,11 +419,14 @@ class Simulation:
                self.rec_slips.copy(), [self.wall_angle(k) for k in self.rec_walls])
         self.rec_slips[:] = 0
         stats = (len(self.contacts.key), self.kinetic_energy()) if self.scene.output.stats else None
+        slip = None
+        if self.slip_stats:
+            slip = self.slip_statistics()
         energy = None
         if self.energy:
             energy = (self.kinetic_energy(), self.elastic_energy(), self.e_diss, self.e_slip, self.e_dashpot,
                       self.w_grav, self.w_drive)
-        self.rows.append(row + (stats, energy))
+        self.rows.append(row + (stats, energy, slip))
 
     def recording(self, steps=None, wall_time_s=0.0) -> Recording:
         """The rows recorded so far (record_row), as a Recording."""
@@ -407,7 +443,8 @@ class Simulation:
             ekin=np.array([r[8][1] for r in rows]) if stats else None,
             energy={f: np.array([r[9][k] for r in rows]) for k, f in enumerate(ENERGY_FIELDS)}
             if self.energy else None,
-            steps=self.step_no if steps is None else steps, wall_time_s=wall_time_s)
+            steps=self.step_no if steps is None else steps, wall_time_s=wall_time_s,
+            slip_stats=np.array([r[10] for r in rows], float).reshape(R, 4) if self.scene.output.slip_stats else None)
 
     # ------------------------------------------------------------ driver
     def run(self, steps=None, progress=None) -> Recording:

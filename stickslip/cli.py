@@ -69,6 +69,7 @@ def build_parser():
                    help="step: slip tested at the end of each step (the paper); exact: each slip at its "
                         "time inside the step (docs/law.md); default: the scene's")
     r.add_argument("--out", type=_folder, help="output folder (default: runs/SCENE/ENGINE)")
+    r.add_argument("--ranks", type=_count, default=1, help="MPI processes (LIGGGHTS only; default 1)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
 
     pr = sub.add_parser("precision", help="error vs wall time over a ladder of time steps")
@@ -135,8 +136,8 @@ def cmd_run(args):
     overrides = {k: getattr(args, k) for k in ("dt", "duration", "law", "reset", "slip_timing")}
     sc = scene_mod.load(args.scene, **overrides)
     out = args.out or Path("runs") / sc.name / args.engine
-    summary, _ = run_scene(sc, args.engine, out, progress=not args.quiet)
-    shown = {k: v for k, v in summary.items() if k not in ("effects", "notes")}
+    summary, _ = run_scene(sc, args.engine, out, progress=not args.quiet, ranks=args.ranks)
+    shown = {k: v for k, v in summary.items() if k not in ("effects", "notes", "avalanche_list")}
     print(json.dumps(shown, indent=2))
     print(f"wrote {out / 'timeseries.csv'} and {out / 'summary.json'}")
     return 0

@@ -10,6 +10,12 @@ from __future__ import annotations
 # (of which the tangential law's slips and dashpot), work of gravity and of the drive.
 ENERGY = ("e_kin", "e_elastic", "e_dissipated", "e_slip", "e_dashpot", "w_gravity", "w_drive")
 STATS = ("n_contacts", "ekin")
+# Slip statistics with output.slip_stats, over the grain-grain contacts touching at the row
+# (wall contacts are not counted): how many slipped in the row's step, how many of those
+# slide (|V_s|) at or above the dashpot threshold V_d = 2(mu_s - mu_k) Fn / nu_s and above
+# V* = 2(mu_s - mu_k) Fn / (nu_s + Ks dt) (docs/law.md: above them every step slips; nu_s
+# = 0: V_d is infinite), and the sum of |Fs|/Fn over those (its mean: / n_slipping).
+SLIP_STATS = ("n_slipping", "n_slip_above_vd", "n_slip_above_vstar", "slip_fs_fn_sum")
 
 
 def grain(name, dim, rotation):
@@ -39,6 +45,8 @@ def names(scene):
         cols += wall(w)
     if out.stats:
         cols += STATS
+    if out.slip_stats:
+        cols += SLIP_STATS
     if out.energy:
         cols += ENERGY
     return cols
@@ -62,6 +70,8 @@ def frame(scene, rec):
         cols[wall(w)[0]] = rec.angle[:, k]
     if out.stats:
         cols.update(n_contacts=rec.n_contacts, ekin=rec.ekin)
+    if out.slip_stats:
+        cols.update(zip(SLIP_STATS, rec.slip_stats.T))
     if out.energy:
         cols.update({e: rec.energy[e] for e in ENERGY})
     df = pd.DataFrame(cols)

@@ -45,10 +45,12 @@ def prepare_output(out_dir) -> Path:
     return out
 
 
-def run_scene(scene, engine, out_dir, progress=True):
+def run_scene(scene, engine, out_dir, progress=True, ranks=1):
     """Run a validated scene on an engine; write timeseries.csv and summary.json into
-    out_dir; returns (summary, timeseries)."""
+    out_dir; returns (summary, timeseries). ranks > 1: MPI processes (LIGGGHTS only)."""
     adapter = adapters.get(engine)
+    if ranks > 1 and engine != "liggghts":
+        raise SceneError(f"--ranks {ranks}: only LIGGGHTS runs on several MPI processes (engine {engine}: 1)")
     reason = adapter.available()
     if reason is not None:
         raise EngineError(f"engine {engine} is not available: {reason}")
@@ -61,7 +63,7 @@ def run_scene(scene, engine, out_dir, progress=True):
     label = f"{scene.name} [{engine}, {scene.contact.law}, {scene.contact.slip_timing}]"
     with bar(label, scene.steps, enabled=progress) as update:
         try:
-            result = adapter.run(scene, out_dir, update)
+            result = adapter.run(scene, out_dir, update, **({"np_ranks": ranks} if ranks > 1 else {}))
         except (RuntimeError, ValueError, OSError, FloatingPointError) as e:  # the engine's words, one line
             raise EngineError(f"{engine}: {_one_line(e)}") from None
     df = result.timeseries
@@ -75,7 +77,7 @@ def run_scene(scene, engine, out_dir, progress=True):
     summary = {
         "scene": scene.name, "engine": engine, "law": scene.contact.law, "reset": scene.contact.reset,
         "slip_timing": scene.contact.slip_timing, "dt_s": scene.dt, "steps": int(result.steps),
-        "wall_time_s": float(result.wall_time_s), "dimension": scene.dimension, "effects": scene.effects,
+        "wall_time_s": float(result.wall_time_s), "ranks": ranks, "dimension": scene.dimension, "effects": scene.effects,
     }
     summary.update(analysis.summarise(scene, df))
     notes = list(result.notes) + scene_mod.accuracy_warnings(scene) + analysis.warnings(scene, summary)

@@ -11,6 +11,7 @@ LIGGGHTS), and a run whose output is not finite raises an error.
 """
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import subprocess
@@ -183,10 +184,25 @@ class _Script:
         if eff["gravity"]:
             g = np.asarray(sc.gravity, float)
             gn = float(np.linalg.norm(g))
-            if gn > 0:
+            if gn > 0 and sc.gravity_rate:
+                # turning gravity (Scene.gravity_at): fix gravity evaluates the direction at
+                # every force evaluation, `step` being the step whose positions it acts on
+                (r0, t0), t = sc.gravity_spinup, f"step*{_fmt(sc.dt)}"
+                a = f"({_fmt(r0)}*{t}+{_fmt(sc.gravity_rate - r0)}*({t}>{_fmt(t0)})*({t}-{_fmt(t0)}))"
+                ux, uy = (float(c) for c in g[:2] / gn)
+                self.add(f"variable gx equal cos({a})*{ux!r}-sin({a})*{uy!r}",
+                         f"variable gy equal sin({a})*{ux!r}+cos({a})*{uy!r}",
+                         f"fix gravity all gravity {gn!r} vector v_gx v_gy 0.0")
+            elif gn > 0:
                 self.add(f"fix gravity all gravity {gn!r} vector {_vec(g / gn)}")
-        # rotation off: integrate translation only, spins stay zero (nothing paid for them)
-        self.add("fix integrate all nve/sphere" if eff["rotation"] else "fix integrate all nve")
+        # rotation off: integrate translation only, spins stay zero (nothing paid for them);
+        # fixed grains are not integrated: they keep their place and zero velocity and spin
+        moving = "all"
+        fixed = [self.ids[g.name] for g in sc.grains if g.fixed]
+        if fixed:
+            self.add("group fixed id " + _id_ranges(fixed), "group moving subtract all fixed")
+            moving = "moving"
+        self.add(f"fix integrate {moving} nve/sphere" if eff["rotation"] else f"fix integrate {moving} nve")
         for g in sc.grains:
             if g.imposed:
                 comps = " ".join("0.0" if c in g.imposed else "NULL" for c in "xyz")
@@ -209,6 +225,8 @@ class _Script:
         self.walls_of = sorted({c[1] for c in sc.output.contacts if c[1] in self.primitive},
                                key=list(self.primitive).index)
         names = set(sc.output.grains) | {a for a, _ in sc.output.contacts} | {b for _, b in pair_contacts}
+        if sc.output.slip_stats:  # the sliding speed of every contact needs every grain
+            names = set(self.ids)
         # the rows of every dump: at least one grain, so that the steps are always written
         self.recorded = sorted(self.ids[n] for n in names) or [1]
         self.add("group rec id " + _id_ranges(self.recorded))
@@ -233,6 +251,15 @@ class _Script:
                      _full_precision("walls", 8))
         if sc.output.stats:
             self._stats_output(every)
+        if sc.output.slip_stats:
+            # every grain pair's record (ids, Fn, F_s, slip counter) at each recorded step and
+            # at the step before it: a counter that moved between them slipped in the row's
+            # step (columns.SLIP_STATS). The dump's next step comes from a variable.
+            self.add("compute slips all pair/gran/local id history",
+                     f"variable slipnext equal (step%{every}=={every - 1})*(step+1)"
+                     f"+(step%{every}!={every - 1})*((floor(step/{every})+1)*{every}-1)",
+                     f"dump slips all local {every} slips.dump {local.format('slips')}",
+                     "dump_modify slips every v_slipnext", _full_precision("slips", 8))
         self.add(f"thermo {max(1, sc.steps // 50)}", "thermo_style custom step atoms",
                  "thermo_modify norm no", f"run {sc.steps}")
 
@@ -347,6 +374,8 @@ def _timeseries(script, work):
         stats = _read_dump(work / "stats.dump")
         cols.update(zip(columns.STATS, ([int(round(stats[s][0][1])) for s in steps],
                                         [float(stats[s][0][2]) for s in steps])))
+    if sc.output.slip_stats:
+        cols.update(zip(columns.SLIP_STATS, _slip_stats(script, atoms, _read_dump(work / "slips.dump"), steps)))
     df = pd.DataFrame(cols)
     bad = ~np.isfinite(df.to_numpy(dtype=float))
     if bad.any():
@@ -354,6 +383,47 @@ def _timeseries(script, work):
         raise RuntimeError(f"LIGGGHTS produced non-finite values: {df.columns[c]} = {df.iat[r, c]} at t = "
                            f"{df['t'].iat[r]:.6g} s (step {steps[r]}); the run is not usable (see {work / 'screen.txt'})")
     return df
+
+
+def _slip_stats(script, atoms, slips, steps):
+    """columns.SLIP_STATS of every row from the pair records (slips.dump: id1 id2 - Fn F_s(3)
+    count, at each row's step and the step before) and the grains (atoms.dump, every grain):
+    a contact slipped in the row's step when its counter moved from the step before (a new
+    contact: when it is not zero). |V_s| from the dumped velocities and spins, with lever
+    arms to the contact point midway in the overlap (docs/law.md); the dump holds the
+    velocities at the end of the step, pyref the half step's it computes the force with."""
+    sc, p = script.scene, script.scene.contact.law_params(script.scene.effects)
+    radius = np.zeros(len(sc.grains) + 1)
+    for g in sc.grains:
+        radius[script.ids[g.name]] = g.radius
+    rows = []
+    for s in steps:
+        blk = slips.get(s, np.zeros((0, 8)))
+        if not len(blk):
+            rows.append((0, 0, 0, 0.0))
+            continue
+        i, j = blk[:, 0].astype(int), blk[:, 1].astype(int)
+        prev = slips.get(s - 1, np.zeros((0, 8)))
+        before = dict(zip(zip(prev[:, 0].astype(int), prev[:, 1].astype(int)), prev[:, 7]))
+        count = blk[:, 7]
+        sel = (count != np.array([before.get((a, b), 0.0) for a, b in zip(i, j)])) & (count > 0)
+        a = atoms[s]
+        at = {int(k): r for r, k in enumerate(a[:, 0])}
+        ai, aj = a[[at[k] for k in i[sel]]], a[[at[k] for k in j[sel]]]
+        d = aj[:, 1:4] - ai[:, 1:4]
+        dist = np.linalg.norm(d, axis=1)
+        n = d / dist[:, None]
+        half = 0.5 * (radius[i[sel]] + radius[j[sel]] - dist)
+        lever = ((radius[i[sel]] - half)[:, None] * ai[:, 7:10]
+                 + (radius[j[sel]] - half)[:, None] * aj[:, 7:10])
+        v_rel = ai[:, 4:7] - aj[:, 4:7] + np.cross(lever, n)
+        vs = np.linalg.norm(v_rel - np.sum(v_rel * n, axis=1)[:, None] * n, axis=1)
+        fn = blk[sel, 3]
+        drop = 2.0 * (p.mu_s - p.mu_k) * fn
+        ratio = np.linalg.norm(blk[sel, 4:7], axis=1) / np.where(fn > 0, fn, np.inf)
+        rows.append((int(sel.sum()), int(np.sum(vs * p.nu_s >= drop)),
+                     int(np.sum(vs * (p.nu_s + p.ks * sc.dt) >= drop)), float(ratio.sum())))
+    return [list(c) for c in zip(*rows)]
 
 
 def _id_ranges(ids):
@@ -378,15 +448,18 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     script = _Script(scene, work)
     (work / "in.scene").write_text(script.text())
     cmd = [str(launcher or LAUNCHER), "-in", "in.scene", "-log", "log.liggghts", "-echo", "none"]
+    env = None
     if np_ranks > 1:
         cmd = ["mpirun", "-np", str(np_ranks)] + cmd
+        if os.geteuid() == 0:  # OpenMPI refuses root unless told (CI runs as root)
+            env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     t0 = time.perf_counter()
     loop, err = [], []
     with open(work / "screen.txt", "w") as screen:
         # errors="replace": LIGGGHTS 3.8's Error::all() sometimes appends bytes read through
         # a dangling pointer (its "special message"), which are not valid UTF-8
         p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                             encoding="utf-8", errors="replace", cwd=work)
+                             encoding="utf-8", errors="replace", cwd=work, env=env)
         for line in p.stdout:
             screen.write(line)
             fields = line.split()

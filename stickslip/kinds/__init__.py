@@ -3,7 +3,7 @@
 A kind module provides (the contract; report, precision and analysis only loop):
 - NAME, and NAMES: the `[analysis]` keys it needs, each with its rule ("grain": a
   recorded grain, "contact": a recorded contact, "wall": a wall, "turning wall": a
-  turning wall whose angle is recorded), checked when the scene is loaded;
+  turning wall whose angle is recorded, "seconds": a time >= 0), checked when the scene is loaded;
 - summarise(scene, df) -> dict: the headline figures of a run (summary.json);
 - errors(scene, summary, df, ref_summary, ref_df) -> dict: relative error measures of a
   run against a converged reference run (`stickslip precision`);
@@ -20,9 +20,9 @@ A kind module provides (the contract; report, precision and analysis only loop):
 from __future__ import annotations
 
 from ..errors import SceneError
-from . import drag, none, tilt, tray
+from . import drag, drum, none, tilt, tray
 
-KINDS = {k.NAME: k for k in (none, drag, tray, tilt)}
+KINDS = {k.NAME: k for k in (none, drag, tray, tilt, drum)}
 
 
 def get(name):
@@ -52,6 +52,10 @@ def read_names(table, kind, grains, walls, output) -> dict:
         elif rule == "wall":
             if not isinstance(v, str) or v not in {w.name for w in walls}:
                 raise SceneError(f"{where} = {v!r}: must be a wall name")
+        elif rule == "seconds":
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 <= v <= 1e100:
+                raise SceneError(f"{where} = {v!r}: must be a time in seconds, >= 0")
+            v = float(v)
         elif rule == "turning wall":
             if not isinstance(v, str) or v not in turning:
                 raise SceneError(f"{where} = {v!r}: must be a turning wall (with a rotation)")

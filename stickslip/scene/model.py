@@ -50,6 +50,9 @@ class Grain:
     imposed: tuple = ()  # velocity components held at their initial value: "x", "y", "z"
     # initial spin, rad/s, always 3 components (2D: about z only); needs effects.rotation
     angular_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    # held where it starts: zero velocity and spin, whatever the forces (a drum's wall
+    # grains, [[ring]]); it still exerts contact forces on the others
+    fixed: bool = False
 
 
 @dataclass
@@ -76,6 +79,8 @@ class Output:
     contacts: list = field(default_factory=list)  # [grain, grain-or-wall] pairs
     walls: list = field(default_factory=list)
     stats: bool = False
+    # slip statistics of the grain-grain contacts at each row (columns.SLIP_STATS)
+    slip_stats: bool = False
     energy: bool = False  # energy columns (docs/adapters.md); engines that cannot give them refuse
 
 
@@ -94,6 +99,27 @@ class Scene:
     output: Output
     analysis: dict
     source: Path | None = None
+    # gravity turns about +z at this rate, rad/s: g(t) = R_z(gravity_rate * t) gravity.
+    # A still drum under turning gravity is a drum turning the other way under fixed
+    # gravity, less the centrifugal and Coriolis terms (docs/drum.md).
+    gravity_rate: float = 0.0
+    # (rate, duration): gravity turns at this rate first, for this long, then at
+    # gravity_rate (a drum brought quickly to its avalanche angle, then turned slowly)
+    gravity_spinup: tuple = (0.0, 0.0)
+
+    def gravity_angle(self, t) -> float:
+        """The angle gravity has turned by at time t, rad."""
+        rate0, t0 = self.gravity_spinup  # (LIGGGHTS' adapter writes the same arithmetic)
+        return rate0 * t + (self.gravity_rate - rate0) * (t - t0) if t > t0 else rate0 * t
+
+    def gravity_at(self, t) -> np.ndarray:
+        """The gravity vector at time t (the scene's, turned by gravity_angle(t))."""
+        if not (self.gravity_rate or self.gravity_spinup[1]):
+            return self.gravity
+        a = self.gravity_angle(t)
+        c, s = math.cos(a), math.sin(a)
+        g = self.gravity
+        return np.array([c * g[0] - s * g[1], s * g[0] + c * g[1], g[2]])
 
     @property
     def steps(self) -> int:

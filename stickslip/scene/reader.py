@@ -59,6 +59,12 @@ MAX_SCENE_BYTES = 64 << 20
 # one is misread there); more than the run's steps records only the start (allowed: a
 # short trial of a scene keeps its interval).
 MAX_EVERY = 2**31 - 1
+# |gravity_rate| at most this, rad/s: a turn a second is far beyond any drum's avalanche
+# regime (rad/s of ~1e-3 to 1e-1) and keeps g(t) sampled by many steps per turn.
+MAX_GRAVITY_RATE = 2 * math.pi
+# A fill's grains start on a hexagonal lattice this much wider than their largest
+# diameter, jittered inside the slack, so that they do not touch at the start.
+FILL_SLACK = 1.1
 
 # Overrides by name -> (table, key) in the scene file.
 _OVERRIDES = {"dt": ("time", "dt"), "duration": ("time", "duration"), "every": ("output", "every"),
@@ -121,6 +127,20 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
     gravity = top.vector("gravity", dim, required=effects["gravity"])
     if gravity is None:
         gravity = np.zeros(3)
+    gravity_rate = top.number("gravity_rate", 0.0, lo=-MAX_GRAVITY_RATE, hi=MAX_GRAVITY_RATE)
+    if gravity_rate and not (effects["gravity"] and np.any(gravity)):
+        raise SceneError(f"gravity_rate = {gravity_rate:g}: turning gravity needs effects.gravity = true and a "
+                         "non-zero gravity")
+    if gravity_rate and dim != 2:
+        raise SceneError(f"gravity_rate = {gravity_rate:g}: gravity turns about z, in 2D scenes only (dimension = 2)")
+    spinup = (0.0, 0.0)
+    if "gravity_spinup" in top.data:
+        st = _Table(top.get("gravity_spinup"), "gravity_spinup")
+        spinup = (st.number("rate", required=True, lo=-MAX_GRAVITY_RATE, hi=MAX_GRAVITY_RATE),
+                  st.number("duration", required=True, lo=0))
+        st.done()
+        if not gravity_rate:
+            raise SceneError("gravity_spinup: goes with a turning gravity (set gravity_rate)")
 
     contact = _contact(_Table(top.get("contact", required=True), "contact"))
 
@@ -138,7 +158,12 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
     grain_tables = [_Table(g, f"grain[{i}]") for i, g in enumerate(top.array("grain"))]
     lattices = [_Table(b, f"lattice[{i}]") for i, b in enumerate(top.array("lattice"))]
     counts = [_counts(bt, dim) for bt in lattices]
-    n_grains = len(grain_tables) + sum(math.prod(c) for c in counts)
+    rings = [_Table(b, f"ring[{i}]") for i, b in enumerate(top.array("ring"))]
+    fills = [_Table(b, f"fill[{i}]") for i, b in enumerate(top.array("fill"))]
+    if (rings or fills) and dim != 2:
+        raise SceneError(f"{'ring' if rings else 'fill'}: rings and fills are made in 2D scenes only (dimension = 2)")
+    n_grains = (len(grain_tables) + sum(math.prod(c) for c in counts)
+                + sum(_count(t) for t in rings) + sum(_count(t) for t in fills))
     if n_grains > MAX_GRAINS:
         raise SceneError(f"grain, lattice[].counts: {n_grains:.3g} grains; at most {MAX_GRAINS:.0e} per scene "
                          f"(the scene alone would need ~{n_grains * 0.9e3 / 1e9:.0f} GB)")
@@ -162,6 +187,10 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
         gt.done()
     for bt, c in zip(lattices, counts):
         grains.extend(_lattice(bt, dim, len(grains), c))
+    for rt in rings:
+        grains.extend(_ring(rt))
+    for ft in fills:
+        grains.extend(_fill(ft))
     if not grains:
         raise SceneError("grain: a scene needs at least one [[grain]] or [[lattice]]")
     _unique([g.name for g in grains], "grain.name")
@@ -202,7 +231,7 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
     top.done()
 
     scene = Scene(name, description, dim, effects, gravity, contact, dt, duration,
-                  grains, walls, output, analysis, source)
+                  grains, walls, output, analysis, source, gravity_rate, spinup)
     limits = stability_limits(scene)
     cause = min(limits, key=limits.get)
     if dt > limits[cause]:
@@ -263,10 +292,11 @@ def _output(ot, grains, walls) -> Output:
     wnames = {w.name for w in walls}
     output = Output(
         every=ot.integer("every", 1, lo=1, hi=MAX_EVERY),
-        grains=ot.names("grains", gnames, "a grain name"),
+        grains=_grain_names(ot, [g.name for g in grains]),
         contacts=ot.array("contacts"),
         walls=ot.names("walls", wnames, "a wall name"),
         stats=ot.boolean("stats", False),
+        slip_stats=ot.boolean("slip_stats", False),
         energy=ot.boolean("energy", False),
     )
     ot.done()
@@ -530,3 +560,98 @@ def _unique(names, what):
         if n in seen:
             raise SceneError(f"{what}: {n!r} is used twice")
         seen.add(n)
+
+
+def _grain_names(ot: _Table, names):
+    """output.grains: grain names, each once; a name ending in '*' stands for every grain
+    whose name starts with what precedes it, in the scene's order (a fill's grains)."""
+    v = ot.array("grains")
+    out = []
+    for x in v:
+        if isinstance(x, str) and x.endswith("*"):
+            hit = [n for n in names if n.startswith(x[:-1])]
+            if not hit:
+                raise SceneError(f"output.grains: {x!r} matches no grain name")
+            out.extend(hit)
+        elif not isinstance(x, str) or x not in names:
+            raise SceneError(f"output.grains: {_shown(x)} is not a grain name (or a prefix ending in '*')")
+        else:
+            out.append(x)
+    _unique(out, "output.grains")
+    return out
+
+
+def _count(t: _Table):
+    """A ring's or fill's grain count, read before any grain is made (the size check)."""
+    n = t.get("count", required=True)
+    if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_GRAINS:
+        raise SceneError(f"{t.key('count')}: expected a whole number in [1, {MAX_GRAINS:.0e}], got {_shown(n)}")
+    return n
+
+
+def _ring(rt: _Table):
+    """A drum's wall: `count` fixed disks evenly spaced on a circle of centres `radius`
+    about `center`; grains inside touch the bumps between them (the drum's roughness)."""
+    center = rt.vector("center", 2, required=True)
+    radius = rt.number("radius", required=True, lo=0, lo_open=True)
+    grain_radius = rt.number("grain_radius", required=True, lo=0, lo_open=True)
+    density = rt.number("density", required=True, lo=0, lo_open=True)
+    n = _count(rt)
+    prefix = rt.string("prefix", "ring")
+    rt.done()
+    if n < 3:
+        raise SceneError(f"{rt.key('count')} = {n}: a ring needs at least 3 grains")
+    if grain_radius >= radius:
+        raise SceneError(f"{rt.key('grain_radius')} = {grain_radius:g}: must be < ring radius {radius:g}")
+    # neighbours may overlap at most as much as any starting grains (MAX_START_OVERLAP)
+    chord = 2 * radius * math.sin(math.pi / n)
+    if chord < 2 * grain_radius * (1 - MAX_START_OVERLAP):
+        most = int(math.pi / math.asin(min(1.0, grain_radius * (1 - MAX_START_OVERLAP) / radius)))
+        raise SceneError(f"{rt.key('count')} = {n}: neighbours would overlap by more than {MAX_START_OVERLAP:g} "
+                         f"of their radius; at most {most} grains fit on this ring")
+    _check_mass(rt.where, 2, grain_radius, grain_radius, density)
+    a = 2 * math.pi * np.arange(n) / n
+    pos = np.zeros((n, 3))
+    pos[:, 0], pos[:, 1] = center[0] + radius * np.cos(a), center[1] + radius * np.sin(a)
+    return [Grain(f"{prefix}{k}", grain_radius, density, pos[k], np.zeros(3), fixed=True) for k in range(n)]
+
+
+def _fill(ft: _Table):
+    """`count` disks of radii uniform in radius*(1 +- spread) in the lower part of a circle
+    (`center`, `radius`: the room inside a drum), on a hexagonal lattice FILL_SLACK wider
+    than the largest diameter, each jittered inside its slack: the sites lowest under a
+    surface line `slope` degrees steep (rising to +x), so a drum can start from a slope
+    above its avalanche angle and its first avalanche comes at once."""
+    center = ft.vector("center", 2, required=True)
+    room = ft.number("radius", required=True, lo=0, lo_open=True)
+    r = ft.number("grain_radius", required=True, lo=0, lo_open=True)
+    spread = ft.number("radius_spread", 0.0, lo=0, hi=0.5)
+    density = ft.number("density", required=True, lo=0, lo_open=True)
+    n = _count(ft)
+    slope = ft.number("slope", 0.0, lo=-60.0, hi=60.0)
+    seed = ft.integer("seed", 0, lo=0)
+    prefix = ft.string("prefix", "p")
+    ft.done()
+    _check_mass(ft.where, 2, r * (1 - spread), r * (1 + spread), density)
+    rmax = r * (1 + spread)
+    s = 2 * rmax * FILL_SLACK
+    inner = room - rmax - 0.5 * (s - 2 * rmax)  # a site's grain stays clear of the circle
+    sites = int(2 * inner / s) + 2 if inner > 0 else 0
+    if sites * sites * 2 > MAX_GRAINS * 4:
+        raise SceneError(f"{ft.key('radius')} = {room:g}: {room / r:.3g} grain radii; too many lattice sites")
+    k = np.arange(-sites, sites + 1)
+    iy, ix = np.meshgrid(k, k, indexing="ij")
+    xy = np.stack(((ix + 0.5 * (iy % 2)) * s, iy * s * math.sqrt(3) / 2), axis=-1).reshape(-1, 2)
+    xy = xy[np.hypot(xy[:, 0], xy[:, 1]) <= inner] if inner > 0 else xy[:0]
+    if len(xy) < n:
+        raise SceneError(f"{ft.key('count')} = {n}: at most {len(xy)} grains of radius up to {rmax:g} m fit in a "
+                         f"circle of radius {room:g} m (hexagonal sites {s:.3g} m apart)")
+    # lowest sites first below a line at `slope` degrees (the pile's starting surface)
+    a = math.radians(slope)
+    order = np.lexsort((xy[:, 0], xy[:, 1] * math.cos(a) - xy[:, 0] * math.sin(a)))[:n]
+    rng = np.random.default_rng(seed)
+    u = rng.uniform(-1, 1, (n, 3))
+    pos = np.zeros((n, 3))
+    pos[:, :2] = center[:2] + xy[order] + 0.5 * (s - 2 * rmax) * u[:, :2] / math.sqrt(2)
+    radii = r * (1 + spread * u[:, 2])
+    return [Grain(f"{prefix}{k}", float(radii[k]), density, pos[k], np.zeros(3)) for k in range(n)]
