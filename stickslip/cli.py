@@ -1,7 +1,7 @@
 """The `stickslip` command: parses its arguments and calls the module that does the work.
 
 run -> runner.py, precision -> precision.py, thresholds -> thresholds.py,
-bench -> bench.py, report -> report.py. Bad arguments or a bad scene: one line on
+bench -> bench.py, report -> report.py, drum-study -> drum_study.py. Bad arguments or a bad scene: one line on
 stderr, exit status 2; an engine that fails, a file that cannot be written, or a fault of
 ours: one line, exit status 1 (STICKSLIP_TRACEBACK=1 shows the traceback of a fault).
 """
@@ -91,6 +91,22 @@ def build_parser():
     be.add_argument("--out", type=_folder, default=Path("bench"), help="output folder (default: bench)")
     be.add_argument("--reps", type=_count, default=3, help="repetitions per figure (median quoted)")
     be.add_argument("--report", action="store_true", help="also time `stickslip report` (all engines and studies)")
+
+    ds = sub.add_parser("drum-study", help="avalanches in a turning drum on LIGGGHTS: history vs stick-slip "
+                                           "(docs/drum.md); resumes an interrupted study")
+    ds.add_argument("--scene", default="drum", help="the drum scene (default: cases/drum.toml)")
+    ds.add_argument("--out", type=_folder, default=Path("docs/drum"), help="tables and figures (default: docs/drum)")
+    ds.add_argument("--runs", type=_folder, default=Path("runs/drum_study"),
+                    help="the runs, kept for resuming (default: runs/drum_study)")
+    ds.add_argument("--rate", type=_positive, help="drum rate, rad/s (default: the scene's)")
+    ds.add_argument("--duration", type=_positive, default=60.0, help="simulated time per run, s (default: 60)")
+    ds.add_argument("--fill", type=_positive, help="share of the drum filled (default: the scene's grain count)")
+    ds.add_argument("--seed", type=int, help="the fill's random seed (default: the scene's)")
+    ds.add_argument("--only", nargs="+", help="run only these runs of the matrix (labels)")
+    ds.add_argument("--no-checks", action="store_true", help="leave out the half-rate and half-dt runs")
+    ds.add_argument("--ranks", type=_count, default=os.cpu_count() or 1, help="MPI ranks (default: every core)")
+    ds.add_argument("--keep-timeseries", action="store_true", help="keep each run's full time series (~100 MB)")
+    ds.add_argument("--quiet", action="store_true", help="no progress bars")
 
     rep = sub.add_parser("report", help="run the paper's cases on every available engine; figures + report.md")
     rep.add_argument("--out", type=_folder, default=Path("report"), help="output folder (default: report)")
@@ -191,6 +207,21 @@ def cmd_bench(args):
     return 0
 
 
+def cmd_drum_study(args):
+    import tomllib
+
+    from .drum_study import run_study
+
+    path = scene_mod.find(args.scene)
+    rate = args.rate or abs(tomllib.loads(path.read_text()).get("gravity_rate", 0.0)) or None
+    if rate is None:
+        raise SceneError(f"--scene {args.scene}: not a turning drum (no gravity_rate); give --rate")
+    run_study(path, args.out, args.runs, rate, args.duration, fill=args.fill, seed=args.seed, labels=args.only,
+              full=not args.no_checks, ranks=args.ranks, keep_timeseries=args.keep_timeseries,
+              progress=not args.quiet)
+    return 0
+
+
 def cmd_report(args):
     from .report import build_report
     from .runner import prepare_output
@@ -200,7 +231,7 @@ def cmd_report(args):
 
 
 COMMANDS = {"run": cmd_run, "precision": cmd_precision, "thresholds": cmd_thresholds, "bench": cmd_bench,
-            "report": cmd_report}
+            "report": cmd_report, "drum-study": cmd_drum_study}
 
 if __name__ == "__main__":
     sys.exit(main())

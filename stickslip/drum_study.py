@@ -1,0 +1,229 @@
+"""`stickslip drum-study`: avalanches in the turning drum, stock history against
+stick-slip (issue 24; the findings: docs/drum.md).
+
+A matrix of runs of cases/drum.toml on LIGGGHTS with MPI (all cores), one after another.
+The cost is stated before the first starts; each run's results stay on disk under
+`runs/<label>/` (summary.json and slope.csv: t, theta, kinetic energy, slip statistics),
+so an interrupted study resumes with the runs it has not finished. Then a table
+(study.csv, avalanches.csv), figures and study.md go to `--out` (docs/drum by default).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import sys
+import time
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import runner
+from .errors import SceneError
+from .kinds import drum
+from .scene import find, parse
+
+# Stock history is stick_slip with mu_k = mu_s and no tangential damping (the slip then
+# drops the force to mu Fn and leaves it there: a cap, as history's; docs/law.md).
+HISTORY_MUS = (0.5, 0.45, 0.4, 0.3, 0.2)
+PAPER_NU_S = 33.10
+
+
+def matrix(rate, full=True):
+    """[(label, contact settings, rate, duration factor, dt factor)] of the study."""
+    runs = [(f"history_mu{mu:.2f}", {"mu_s": mu, "mu_k": mu, "nu_s": 0.0}, rate, 1, 1) for mu in HISTORY_MUS]
+    ss = {"mu_s": 0.5, "mu_k": 0.45, "nu_s": PAPER_NU_S}
+    runs += [
+        ("ss_0.50_0.45_step", dict(ss, slip_timing="step"), rate, 1, 1),
+        ("ss_0.50_0.45_exact", dict(ss, slip_timing="exact"), rate, 1, 1),
+        ("ss_0.50_0.45_nus0_exact", dict(ss, nu_s=0.0, slip_timing="exact"), rate, 1, 1),
+        ("ss_0.50_0.45_total_step", dict(ss, reset="total", slip_timing="step"), rate, 1, 1),
+        ("ss_0.50_0.35_step", dict(ss, mu_k=0.35, slip_timing="step"), rate, 1, 1),
+        ("ss_0.50_0.35_exact", dict(ss, mu_k=0.35, slip_timing="exact"), rate, 1, 1),
+    ]
+    if full:  # the checks of the setting: the rate halved, the step halved
+        runs += [
+            ("history_mu0.50_half_rate", {"mu_s": 0.5, "mu_k": 0.5, "nu_s": 0.0}, rate / 2, 1.5, 1),
+            ("ss_0.50_0.35_step_half_rate", dict(ss, mu_k=0.35, slip_timing="step"), rate / 2, 1.5, 1),
+            ("ss_0.50_0.35_step_half_dt", dict(ss, mu_k=0.35, slip_timing="step"), rate, 1, 0.5),
+        ]
+    return runs
+
+
+SMOKE_LABELS = ("history_mu0.50", "ss_0.50_0.35_step")
+
+# LIGGGHTS' speed on this scene, grain-steps per second (2 ranks on the 2-core machine:
+# 4.3e8 grain-steps in 24.6 s; 1 rank about half): only to say beforehand what a study costs.
+SPEED = {1: 9e6, 2: 1.7e7}
+# The avalanche regime: the drum turns by at most MAX_TURN_PER_AVALANCHE (rad) while an
+# avalanche runs, which lasts ~5 sqrt(D/g) (0.4-1.2 s measured in this drum, D = 88 mm).
+MAX_TURN_PER_AVALANCHE = math.radians(1.0)
+# The fill fraction (of the drum's area under the pile at packing 0.82) the study accepts.
+FILL_RANGE = (0.2, 0.7)
+PACKING = 0.82
+
+
+def scene_data(base, settings, rate, duration, dt_factor, fill, seed):
+    """The drum's TOML data with the run's settings written in."""
+    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in base.items()}
+    data["contact"].update(settings)
+    data["gravity_rate"] = math.copysign(rate, base["gravity_rate"])
+    data["time"]["duration"] = duration
+    data["time"]["dt"] = base["time"]["dt"] * dt_factor
+    data["output"]["every"] = max(1, int(round(base["output"]["every"] / dt_factor)))
+    fills = [dict(f) for f in base["fill"]]
+    if fill is not None:
+        f = fills[0]
+        room = math.pi * f["radius"] ** 2
+        mean_area = math.pi * f["grain_radius"] ** 2 * (1 + f.get("radius_spread", 0.0) ** 2 / 3)
+        f["count"] = int(round(fill * room * PACKING / mean_area))
+    if seed is not None:
+        fills[0]["seed"] = seed
+    data["fill"] = fills
+    return data
+
+
+def check(scene_path, rate, fill, duration):
+    """Refuse settings outside the avalanche regime or a fill that cannot be made: one line."""
+    base = tomllib.loads(Path(scene_path).read_text())
+    ring = base["ring"][0]
+    diameter = 2 * (ring["radius"] - ring["grain_radius"])
+    g = math.hypot(*base["gravity"])
+    most = MAX_TURN_PER_AVALANCHE / (5 * math.sqrt(diameter / g))
+    if not 0 < rate <= most:
+        raise SceneError(f"--rate {rate:g}: must be in (0, {most:.3g}] rad/s (the avalanche regime: the drum turns "
+                         f"at most {math.degrees(MAX_TURN_PER_AVALANCHE):g} deg during an avalanche of "
+                         f"~5 sqrt(D/g) = {5 * math.sqrt(diameter / g):.2g} s)")
+    if fill is not None and not FILL_RANGE[0] <= fill <= FILL_RANGE[1]:
+        raise SceneError(f"--fill {fill:g}: must be in [{FILL_RANGE[0]}, {FILL_RANGE[1]}] (share of the drum "
+                         "filled: below, no slope to measure; above, no room for it to avalanche)")
+    settle = base["analysis"]["settle"]
+    if duration <= settle + 5:
+        raise SceneError(f"--duration {duration:g}: must be > {settle + 5:g} s (the first {settle:g} s settle)")
+    return base
+
+
+def plan(scene_path, out_runs, rate, duration, fill, seed, labels, full):
+    base = check(scene_path, rate, fill, duration)
+    chosen = [r for r in matrix(rate, full) if labels is None or r[0] in labels]
+    unknown = sorted(set(labels or ()) - {r[0] for r in matrix(rate, True)})
+    if unknown:
+        raise SceneError(f"--only {unknown[0]}: not a run of the study (runs: {', '.join(r[0] for r in matrix(rate))})")
+    jobs = []
+    for label, settings, r, dur_factor, dt_factor in chosen:
+        data = scene_data(base, settings, r, duration * dur_factor, dt_factor, fill, seed)
+        data["name"] = f"drum_{label}"
+        try:
+            sc = parse(data, source=Path(scene_path))
+        except SceneError as e:
+            raise SceneError(f"run {label}: {e}") from None
+        jobs.append((label, sc, data, Path(out_runs) / label))
+    return jobs
+
+
+def _done(folder, data):
+    """A run is finished when its summary and slope series are on disk for the same settings."""
+    try:
+        return (json.loads((folder / "settings.json").read_text()) == data
+                and (folder / "summary.json").is_file() and (folder / "slope.csv").is_file())
+    except (OSError, ValueError):
+        return False
+
+
+def run_study(scene_path, out, out_runs, rate, duration, fill=None, seed=None, labels=None, full=True, ranks=2,
+              keep_timeseries=False, progress=True):
+    jobs = plan(scene_path, out_runs, rate, duration, fill, seed, labels, full)
+    todo = [j for j in jobs if not _done(j[3], _jsonable(j[2]))]
+    cost = {j[0]: j[1].steps * len(j[1].grains) / SPEED.get(ranks, SPEED[1] * ranks) for j in todo}
+    say = sys.stderr.write
+    say(f"stickslip drum-study: {len(jobs)} runs, {len(jobs) - len(todo)} already on disk in {out_runs}; "
+        f"{len(todo)} to run on LIGGGHTS ({ranks} MPI ranks), about {sum(cost.values()) / 60:.0f} min\n")
+    t_start = time.perf_counter()
+    for k, (label, sc, data, folder) in enumerate(todo):
+        left = sum(cost[j[0]] for j in todo[k:])
+        say(f"[{k + 1}/{len(todo)}] {label}: {sc.steps:,} steps x {len(sc.grains)} grains, ~{cost[label]:.0f} s "
+            f"(study: ~{left / 60:.0f} min left, {(time.perf_counter() - t_start) / 60:.1f} min so far)\n")
+        tmp = folder.with_name(folder.name + ".part")
+        if tmp.exists():
+            shutil.rmtree(tmp)
+        summary, df = runner.run_scene(sc, "liggghts", tmp, progress=progress, ranks=ranks)
+        theta = drum.slope_angles(sc, df)
+        keep = ["t", "ekin", "n_contacts"] + [c for c in df.columns if c in _SLIP_COLUMNS]
+        slope = df[keep].copy()
+        slope.insert(1, "theta_deg", theta)
+        slope.to_csv(tmp / "slope.csv", index=False)
+        (tmp / "settings.json").write_text(json.dumps(_jsonable(data), indent=1))
+        if not keep_timeseries:  # every grain every row: ~100 MB a run
+            (tmp / "timeseries.csv").unlink()
+            shutil.rmtree(tmp / "liggghts", ignore_errors=True)
+        if folder.exists():
+            shutil.rmtree(folder)
+        os.replace(tmp, folder)  # a run is on disk whole, or not at all
+    return write_results(jobs, Path(out))
+
+
+_SLIP_COLUMNS = ("n_slipping", "n_slip_above_vd", "n_slip_above_vstar", "slip_fs_fn_sum")
+
+
+def _jsonable(data):
+    return json.loads(json.dumps(data))
+
+
+def load_run(folder):
+    summary = json.loads((folder / "summary.json").read_text())
+    return summary, pd.read_csv(folder / "slope.csv")
+
+
+STUDY_COLUMNS = ("label", "mu_s", "mu_k", "nu_s", "reset", "slip_timing", "rate_rad_s", "dt_s", "duration_s",
+                 "avalanches", "slides", "theta_start_mean_deg", "theta_start_se_deg", "theta_stop_mean_deg",
+                 "theta_stop_se_deg", "delta_theta_mean_deg", "delta_theta_se_deg", "avalanche_share_above_vd",
+                 "avalanche_share_above_vstar", "avalanche_slip_fs_fn", "wall_time_s")
+
+
+def write_results(jobs, out):
+    out.mkdir(parents=True, exist_ok=True)
+    rows, events = [], []
+    for label, sc, _, folder in jobs:
+        run_summary, slope = load_run(folder)
+        # measured again from the slope series: the figures follow kinds/drum.py as it is now
+        summary = dict(run_summary, **drum.summarise(sc, slope, slope["theta_deg"].to_numpy()))
+        c = sc.contact
+        row = {"label": label, "mu_s": c.mu_s, "mu_k": c.mu_k, "nu_s": c.nu_s, "reset": c.reset,
+               "slip_timing": c.slip_timing, "rate_rad_s": abs(sc.gravity_rate), "dt_s": sc.dt,
+               "duration_s": sc.duration}
+        row.update({k: summary.get(k, math.nan) for k in STUDY_COLUMNS if k not in row})
+        rows.append(row)
+        for e in summary["avalanche_list"]:
+            events.append({"label": label, **e, "avalanche": e["delta_theta"] >= drum.MIN_DROP})
+    study = pd.DataFrame(rows, columns=STUDY_COLUMNS)
+    study.to_csv(out / "study.csv", index=False)
+    pd.DataFrame(events).to_csv(out / "avalanches.csv", index=False)
+    from . import drum_figures
+    figs = drum_figures.draw(out, study, pd.DataFrame(events), {j[0]: j[3] for j in jobs})
+    (out / "study.md").write_text(_table(study, figs))
+    print(f"wrote {out / 'study.csv'}, {out / 'avalanches.csv'}, {out / 'study.md'} and {len(figs)} figures")
+    return study
+
+
+def _table(study, figs):
+    def pm(m, se):
+        return "—" if not np.isfinite(m) else f"{m:.2f} ± {se:.2f}" if np.isfinite(se) else f"{m:.2f}"
+
+    lines = ["# Drum study: the table", "",
+             "Written by `stickslip drum-study` (stickslip/drum_study.py); the findings: [../drum.md](../drum.md). "
+             "Means over the avalanches of each run with their standard errors (std / sqrt(n)); angles in degrees.",
+             "", "| run | μs | μk | νs | reset | timing | rate (rad/s) | dt (s) | avalanches (slides) | θ_start | θ_stop "
+             "| δθ | slipping above V_d | above V* | ⟨abs(Fs)/Fn⟩ slipping |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for _, r in study.iterrows():
+        lines.append(f"| {r.label} | {r.mu_s:g} | {r.mu_k:g} | {r.nu_s:g} | {r.reset} | {r.slip_timing} | "
+                     f"{r.rate_rad_s:g} | {r.dt_s:g} | {int(r.avalanches)} ({int(r.slides)}) | "
+                     f"{pm(r.theta_start_mean_deg, r.theta_start_se_deg)} | "
+                     f"{pm(r.theta_stop_mean_deg, r.theta_stop_se_deg)} | "
+                     f"{pm(r.delta_theta_mean_deg, r.delta_theta_se_deg)} | {r.avalanche_share_above_vd:.2f} | "
+                     f"{r.avalanche_share_above_vstar:.2f} | {r.avalanche_slip_fs_fn:.3f} |")
+    lines += [""] + [f"![{f}]({f})" for f in figs] + [""]
+    return "\n".join(lines)
