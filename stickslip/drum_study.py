@@ -154,6 +154,7 @@ def run_study(scene_path, out, out_runs, rate, duration, fill=None, seed=None, l
         keep = ["t", "ekin", "n_contacts"] + [c for c in df.columns if c in _SLIP_COLUMNS]
         slope = df[keep].copy()
         slope.insert(1, "theta_deg", theta)
+        slope.insert(2, "theta_centroid_deg", drum.centroid_angles(sc, df))
         slope.to_csv(tmp / "slope.csv", index=False)
         (tmp / "settings.json").write_text(json.dumps(_jsonable(data), indent=1))
         if not keep_timeseries:  # every grain every row: ~100 MB a run

@@ -86,6 +86,24 @@ def energy_scale(scene):
     return m * float(np.hypot(*scene.gravity[:2])) * 2.0 * r.mean()
 
 
+def centroid_angles(scene, df):
+    """A cross-check of theta: the angle (degrees) between gravity and the line from the
+    drum's centre to the pile's centroid (area-weighted). A flat surface in a circular drum
+    is perpendicular to that line, so this is its slope, averaged over the whole surface;
+    it moves exactly with the pile, without the fit's dependence on which grain tops a bin."""
+    names, r = mobile(scene)
+    w = r**2 / np.sum(r**2)
+    cx = df[[f"{n}_x" for n in names]].to_numpy(float) @ w - centre(scene)[0]
+    cy = df[[f"{n}_y" for n in names]].to_numpy(float) @ w - centre(scene)[1]
+    sign = -1.0 if scene.gravity_rate > 0 else 1.0
+    out = np.empty(len(df))
+    for k, t in enumerate(df["t"].to_numpy(float)):
+        g = scene.gravity_at(t)[:2]
+        # the centroid's angle from "down", counter-clockwise positive
+        out[k] = math.degrees(math.atan2(g[0] * cy[k] - g[1] * cx[k], g[0] * cx[k] + g[1] * cy[k]))
+    return sign * out
+
+
 def avalanches(scene, df):
     """[(first row, last row)] of each avalanche that starts after `settle` and has ended."""
     scale = energy_scale(scene)

@@ -1,0 +1,242 @@
+"""The turning drum (issue 24): its scene format, its physics on pyref and LIGGGHTS, the
+kind that measures its avalanches, and the study command's refusals."""
+import copy
+import math
+import tomllib
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from stickslip import columns
+from stickslip import scene as scene_mod
+from stickslip.adapters import liggghts as liggghts_adapter
+from stickslip.cli import main
+from stickslip.kinds import drum
+from pyref import Simulation
+
+needs_liggghts = pytest.mark.skipif(liggghts_adapter.available() is not None,
+                                    reason=str(liggghts_adapter.available()))
+BASE = tomllib.loads(scene_mod.find("drum").read_text())
+
+
+def drum_data(**changes):
+    """cases/drum.toml's data with changes: {"table.key": value} (a list index: "fill.0.count")."""
+    data = copy.deepcopy(BASE)
+    for path, value in changes.items():
+        *head, last = path.split(".")
+        node = data
+        for h in head:
+            node = node[int(h)] if isinstance(node, list) else node[h]
+        if value is None:
+            node.pop(last, None)
+        elif isinstance(node, list):
+            node[int(last)] = value
+        else:
+            node[last] = value
+    return data
+
+
+# ---------------------------------------------------------------- scene format
+
+@pytest.mark.parametrize("changes, words", [
+    ({"ring.0.count": 2}, ["ring[0].count", "at least 3"]),
+    ({"ring.0.count": 90}, ["ring[0].count", "at most 80"]),
+    ({"ring.0.grain_radius": 0.05}, ["ring[0].grain_radius", "< ring radius"]),
+    ({"fill.0.count": 400}, ["fill[0].count", "at most"]),
+    ({"fill.0.radius_spread": 0.7}, ["fill[0].radius_spread", "<= 0.5"]),
+    ({"fill.0.slope": 75.0}, ["fill[0].slope", "<= 60"]),
+    ({"fill.0.colour": 1}, ["fill[0].colour", "unknown key"]),
+    ({"gravity_rate": 7.0}, ["gravity_rate", "<= 6.28"]),
+    ({"effects.gravity": False}, ["gravity_rate", "effects.gravity = true"]),
+    ({"gravity_spinup": {"rate": -0.3}}, ["gravity_spinup.duration", "missing"]),
+    ({"gravity_rate": None}, ["gravity_spinup", "gravity_rate"]),
+    ({"output.grains": ["q*"]}, ["output.grains", "'q*' matches no grain"]),
+    ({"analysis.settle": -1.0}, ["analysis.settle", ">= 0"]),
+])
+def test_bad_drum_scene_is_one_line_naming_the_key(changes, words):
+    with pytest.raises(scene_mod.SceneError) as e:
+        scene_mod.parse(drum_data(**changes))
+    msg = str(e.value)
+    assert "\n" not in msg
+    for w in words:
+        assert w in msg, (w, msg)
+
+
+def test_ring_and_fill_make_a_drum_whose_grains_do_not_overlap():
+    sc = scene_mod.load("drum")
+    ring = [g for g in sc.grains if g.fixed]
+    fill = [g for g in sc.grains if not g.fixed]
+    assert len(ring) == BASE["ring"][0]["count"] and len(fill) == BASE["fill"][0]["count"]
+    x = np.array([g.position[:2] for g in sc.grains])
+    r = np.array([g.radius for g in sc.grains])
+    d = np.linalg.norm(x[:, None] - x[None], axis=2) - (r[:, None] + r[None])
+    np.fill_diagonal(d, np.inf)
+    moving = ~np.array([g.fixed for g in sc.grains])
+    assert d[moving].min() > 0  # no grain of the fill touches another or the wall at the start
+    spread = BASE["fill"][0]["radius_spread"] * BASE["fill"][0]["grain_radius"]
+    assert np.abs(r[moving] - BASE["fill"][0]["grain_radius"]).max() <= spread
+    room = BASE["fill"][0]["radius"]
+    assert (np.linalg.norm(x[moving], axis=1) + r[moving]).max() <= room
+    # the pile starts under a line at fill.slope: its highest grains lie along it
+    assert sc.output.grains == [g.name for g in fill]
+
+
+def test_fixed_grains_stay_put_and_gravity_turns_on_pyref():
+    """A short pyref run: the ring does not move or spin although the pile presses on it,
+    and the moving grains fall along the gravity of each step."""
+    sc = scene_mod.load("drum", duration=0.02, every=100)
+    sim = Simulation(sc)
+    x0 = sim.x[sim.fixed].copy()
+    sim.run()
+    assert np.array_equal(sim.x[sim.fixed], x0)
+    assert not sim.v[sim.fixed].any() and not sim.w[sim.fixed].any()
+    assert np.array_equal(sim.g, sc.gravity_at(sc.steps * sc.dt))
+
+
+def free_fall(rate, spinup, duration=0.1, dt=1e-4):
+    """One grain falling freely under turning gravity."""
+    data = {"name": "fall", "dimension": 2, "gravity": [0.0, -9.81], "gravity_rate": rate,
+            "gravity_spinup": {"rate": spinup[0], "duration": spinup[1]},
+            "effects": {"gravity": True}, "contact": {"kn": 1e5, "ks": 1e5, "mu_s": 0.5, "mu_k": 0.5},
+            "time": {"dt": dt, "duration": duration}, "output": {"every": 100, "grains": ["g"]},
+            "grain": [{"name": "g", "radius": 0.01, "density": 1000, "position": [0.0, 0.0]}]}
+    return scene_mod.parse(data)
+
+
+def exact_velocity(sc, t):
+    """v(t) = integral of g(s) ds, by a quadrature far finer than the run's steps."""
+    s = np.linspace(0, t, 200001)
+    g = np.array([sc.gravity_at(u)[:2] for u in s])
+    return np.trapezoid(g, s, axis=0)
+
+
+@pytest.mark.parametrize("engine", ["pyref", pytest.param("liggghts", marks=needs_liggghts)])
+def test_turning_gravity_is_the_gravity_of_each_step(engine, tmp_path):
+    """Velocity Verlet averages the force of a step's two ends (trapezoid rule), so the
+    velocity of a free grain under g(t) is off by at most t dt^2 max|g''| / 12 (smooth
+    parts) plus dt^2 |g| |rate - spinup rate| / 4 at the kink where the rate changes;
+    gravity taken one step late would be off by ~ |g| rate dt t / 2, 1e3 times more here."""
+    sc = free_fall(rate=-0.5, spinup=(2.0, 0.05))
+    if engine == "pyref":
+        df = columns.frame(sc, Simulation(sc).run())
+    else:
+        df = liggghts_adapter.run(sc, tmp_path).timeseries
+    g = 9.81
+    bound = sc.duration * sc.dt**2 * g * 2.0**2 / 12 + sc.dt**2 * g * 2.5 / 4 + 1e-12
+    late = g * 0.5 * sc.dt * sc.duration / 2
+    assert bound < late / 100
+    for k in (len(df) // 2, len(df) - 1):
+        t = df["t"].iloc[k]
+        v = np.array([df["g_vx"].iloc[k], df["g_vy"].iloc[k]])
+        assert np.abs(v - exact_velocity(sc, t)).max() <= bound, (t, v, exact_velocity(sc, t))
+
+
+# ---------------------------------------------------------------- the kind
+
+def test_slope_measures_follow_a_turned_pile():
+    """Turning every grain of a pile about the drum's centre by alpha (gravity fixed) turns
+    the centroid's angle by exactly alpha, and turning gravity with it leaves both measures
+    unchanged: their frames and signs are right. The fit follows the turn only roughly on
+    this pile (a lattice's rows are steps on its surface; which grain tops a bin changes
+    as it turns): the same sign, within 5 deg."""
+    sc = scene_mod.parse(drum_data(**{"fill.0.count": 120, "fill.0.slope": 20.0}))  # its surface: a slope
+    names, _ = drum.mobile(sc)
+    x0 = np.array([[g.position[0], g.position[1]] for g in sc.grains if not g.fixed])
+
+    def record(alpha, t=0.0):
+        a = math.radians(alpha)
+        c, s = math.cos(a), math.sin(a)
+        xy = x0 @ np.array([[c, s], [-s, c]])  # turned counter-clockwise by alpha
+        return pd.DataFrame([{"t": t, **{f"{n}_x": p[0] for n, p in zip(names, xy)},
+                              **{f"{n}_y": p[1] for n, p in zip(names, xy)}}])
+
+    turned = pd.concat([record(a) for a in (0.0, 5.0, 10.0)], ignore_index=True)
+    com, fit = drum.centroid_angles(sc, turned), drum.slope_angles(sc, turned)
+    # gravity_rate < 0 counts slopes rising to +x as positive: turning the pile
+    # counter-clockwise steepens it
+    assert com[1] - com[0] == pytest.approx(5.0, abs=1e-9)
+    assert com[2] - com[0] == pytest.approx(10.0, abs=1e-9)
+    assert 5.0 < fit[2] - fit[0] < 15.0
+    # the pile and gravity turned together: gravity has turned by gravity_angle(t) at t
+    t = 3.0
+    together = record(math.degrees(sc.gravity_angle(t)), t)
+    assert drum.centroid_angles(sc, together)[0] == pytest.approx(com[0], abs=1e-9)
+    assert drum.slope_angles(sc, together)[0] == pytest.approx(fit[0], abs=1e-6)
+
+
+def test_avalanches_are_found_in_the_kinetic_energy():
+    """A made-up record: the slope rises, two energy bursts (one an avalanche that lowers
+    the slope by 6 deg, one a slide that lowers it by 0.2 deg), one burst before settle."""
+    sc = scene_mod.load("drum")
+    scale = drum.energy_scale(sc)
+    t = np.arange(0, 20, 0.01)
+    theta = 20 + 1.0 * t
+    ekin = np.full(len(t), 1e-9 * scale)
+    for t0, t1, drop in ((1.995, 2.505, 5.0), (7.995, 8.605, 6.0), (13.995, 14.305, 0.2)):
+        on = (t >= t0) & (t <= t1)
+        ekin[on] = (1e-3 if drop > 1 else 2e-4) * scale
+        theta[t > t1] -= drop
+    df = pd.DataFrame({"t": t, "ekin": ekin, **{c: np.zeros(len(t)) for c in columns.SLIP_STATS}})
+    s = drum.summarise(sc, df, theta)
+    assert s["avalanches"] == 1 and s["slides"] == 1  # the burst at 2 s is before settle = 4 s
+    a = s["avalanche_list"][0]
+    assert a["theta_start"] == pytest.approx(20 + 7.99 - 5.0, abs=1e-9)
+    assert a["theta_stop"] == pytest.approx(20 + 8.61 - 11.0, abs=1e-9)
+    assert s["delta_theta_mean_deg"] == pytest.approx(6.0 - 0.62, abs=1e-9)
+
+
+# ---------------------------------------------------------------- engines, step for step
+
+@needs_liggghts
+def test_drum_on_liggghts_is_pyrefs_step_for_step(tmp_path):
+    """The drum's first 0.05 s (5000 steps: the fill falls, hits the ring and itself,
+    ~300 contacts, rolling, slips, turning gravity) on LIGGGHTS and pyref. Both solve the
+    same equations, so they differ by round-off, amplified by the collisions (the pile is
+    chaotic: the difference grows ~e-fold every 4 ms, 1e-20 m at the first contacts to
+    ~1e-12 m at 0.05 s, and ~1 mm by 0.2 s, where the trajectories part). Any difference
+    in the physics shows far above 1e-10 m: lever arms of r instead of r - delta/2 gave
+    1.6e-8 m 0.01 s after the first contacts. The slip statistics are counts: equal."""
+    sc = scene_mod.load("drum", duration=0.05, every=250)
+    dl = liggghts_adapter.run(sc, tmp_path).timeseries
+    dp = columns.frame(sc, Simulation(sc).run())
+    assert list(dl.columns) == list(dp.columns)
+    pos = [c for c in dp.columns if c.endswith(("_x", "_y"))]
+    assert np.abs(dl[pos].to_numpy() - dp[pos].to_numpy()).max() < 1e-10
+    assert dp["n_slipping"].sum() > 100
+    for c in ("n_slipping", "n_slip_above_vd", "n_contacts"):
+        assert (dl[c] == dp[c]).all(), c
+    assert np.abs(dl["slip_fs_fn_sum"] - dp["slip_fs_fn_sum"]).max() < 1e-9
+
+
+@needs_liggghts
+def test_drum_on_two_mpi_ranks_is_one_ranks(tmp_path):
+    """The same 0.05 s on 1 and 2 MPI ranks: the ranks split the drum, so sums run in
+    another order; the same round-off bound as against pyref."""
+    sc = scene_mod.load("drum", duration=0.05, every=250)
+    d1 = liggghts_adapter.run(sc, tmp_path / "one").timeseries
+    d2 = liggghts_adapter.run(sc, tmp_path / "two", np_ranks=2).timeseries
+    pos = [c for c in d1.columns if c.endswith(("_x", "_y"))]
+    assert np.abs(d1[pos].to_numpy() - d2[pos].to_numpy()).max() < 1e-10
+    assert (d1["n_slipping"] == d2["n_slipping"]).all()
+
+
+# ---------------------------------------------------------------- the study's refusals
+
+@pytest.mark.parametrize("args, words", [
+    (["--rate", "0.1"], ["--rate 0.1", "(0, 0.0369]", "avalanche regime"]),
+    (["--fill", "0.95"], ["--fill 0.95", "[0.2, 0.7]"]),
+    (["--duration", "5"], ["--duration 5", "> 9"]),
+    (["--only", "history_mu0.99"], ["--only history_mu0.99", "not a run"]),
+    (["--colour", "red"], ["unrecognized arguments"]),
+])
+def test_drum_study_refuses_bad_settings_in_one_line(args, words, tmp_path, capsys):
+    try:
+        code = main(["drum-study", "--runs", str(tmp_path / "runs"), "--out", str(tmp_path / "out"), *args])
+    except SystemExit as e:  # argparse's refusal of an unknown option
+        code = e.code
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "\n" not in err
+    for w in words:
+        assert w in err, (w, err)
+    assert not (tmp_path / "runs").exists()
