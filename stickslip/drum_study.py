@@ -228,3 +228,28 @@ def _table(study, figs):
                      f"{r.avalanche_share_above_vstar:.2f} | {r.avalanche_slip_fs_fn:.3f} |")
     lines += [""] + [f"![{f}]({f})" for f in figs] + [""]
     return "\n".join(lines)
+
+
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "drum"
+
+
+def report_section(report_dir, docs=DOCS):
+    """The report's drum section: the finished study's table and figures (the report does
+    not run the study: it takes ~45 min), or how to run it."""
+    lines = ["", "## Granular scale: avalanches in a turning drum", ""]
+    if not (docs / "study.csv").is_file():
+        return "\n".join(lines + ["No finished drum study is present. Run it (LIGGGHTS with MPI, ~45 min on 2 "
+                                  "cores, resumable): `.venv/bin/stickslip drum-study`; it writes docs/drum/.", ""])
+    rel = os.path.relpath(docs, report_dir)
+    study = pd.read_csv(docs / "study.csv")
+    lines += [f"From the finished study in [{rel}/study.md]({rel}/study.md) ({len(study)} runs; the findings and the "
+              f"calibration recipe: [{rel}/../drum.md]({rel}/../drum.md)). Means ± standard errors, degrees.", "",
+              "| run | avalanches | θ_start | θ_stop | δθ |", "|---|---|---|---|---|"]
+    for _, r in study.iterrows():
+        lines.append(f"| {r.label} | {int(r.avalanches)} | {r.theta_start_mean_deg:.2f} ± {r.theta_start_se_deg:.2f} "
+                     f"| {r.theta_stop_mean_deg:.2f} ± {r.theta_stop_se_deg:.2f} | "
+                     f"{r.delta_theta_mean_deg:.2f} ± {r.delta_theta_se_deg:.2f} |")
+    lines.append("")
+    for png in sorted(docs.glob("drum_*.png")):
+        lines += [f"![{png.stem}]({rel}/{png.name})", ""]
+    return "\n".join(lines)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from . import adapters, kinds, parallel, runner
+from . import adapters, drum_study, kinds, parallel, runner
 from .kinds import paper
 from . import scene as scene_mod
 from .studies import plan as study_plan
@@ -56,6 +56,7 @@ def build_report(out: Path, engines=None, progress=True, studies=True):
     text = _markdown(results, engines, skipped, figs)
     if studies:
         text += finish_studies(got[len(tasks):])
+    text += drum_study.report_section(out)
     (out / "report.md").write_text(text)
     print(f"wrote {out / 'report.md'}")
     return 0
