@@ -105,6 +105,8 @@ def build_parser():
     ds.add_argument("--only", nargs="+", help="run only these runs of the matrix (labels)")
     ds.add_argument("--no-checks", action="store_true", help="leave out the half-rate and half-dt runs")
     ds.add_argument("--ranks", type=_count, default=os.cpu_count() or 1, help="MPI ranks (default: every core)")
+    ds.add_argument("--tables-only", action="store_true",
+                    help="write the tables and figures of the runs finished so far; run nothing")
     ds.add_argument("--keep-timeseries", action="store_true", help="keep each run's full time series (~100 MB)")
     ds.add_argument("--quiet", action="store_true", help="no progress bars")
 
@@ -218,7 +220,7 @@ def cmd_drum_study(args):
         raise SceneError(f"--scene {args.scene}: not a turning drum (no gravity_rate); give --rate")
     run_study(path, args.out, args.runs, rate, args.duration, fill=args.fill, seed=args.seed, labels=args.only,
               full=not args.no_checks, ranks=args.ranks, keep_timeseries=args.keep_timeseries,
-              progress=not args.quiet)
+              progress=not args.quiet, tables_only=args.tables_only)
     return 0
 
 

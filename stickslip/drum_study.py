@@ -125,18 +125,23 @@ def plan(scene_path, out_runs, rate, duration, fill, seed, labels, full):
 
 
 def _done(folder, data):
-    """A run is finished when its summary and slope series are on disk for the same settings."""
+    """A run is finished when its summary and slope series are on disk for the same settings
+    (the scene's data but its description: a reworded comment does not call for a rerun)."""
+    def physics(d):
+        return {k: v for k, v in d.items() if k != "description"}
     try:
-        return (json.loads((folder / "settings.json").read_text()) == data
+        return (physics(json.loads((folder / "settings.json").read_text())) == physics(data)
                 and (folder / "summary.json").is_file() and (folder / "slope.csv").is_file())
     except (OSError, ValueError):
         return False
 
 
 def run_study(scene_path, out, out_runs, rate, duration, fill=None, seed=None, labels=None, full=True, ranks=2,
-              keep_timeseries=False, progress=True):
+              keep_timeseries=False, progress=True, tables_only=False):
     jobs = plan(scene_path, out_runs, rate, duration, fill, seed, labels, full)
     todo = [j for j in jobs if not _done(j[3], _jsonable(j[2]))]
+    if tables_only:  # the tables and figures of the runs finished so far
+        return write_results([j for j in jobs if j not in todo], Path(out))
     cost = {j[0]: j[1].steps * len(j[1].grains) / SPEED.get(ranks, SPEED[1] * ranks) for j in todo}
     say = sys.stderr.write
     say(f"stickslip drum-study: {len(jobs)} runs, {len(jobs) - len(todo)} already on disk in {out_runs}; "
@@ -180,7 +185,10 @@ def load_run(folder):
 
 STUDY_COLUMNS = ("label", "mu_s", "mu_k", "nu_s", "reset", "slip_timing", "rate_rad_s", "dt_s", "duration_s",
                  "avalanches", "slides", "theta_start_mean_deg", "theta_start_se_deg", "theta_stop_mean_deg",
-                 "theta_stop_se_deg", "delta_theta_mean_deg", "delta_theta_se_deg", "avalanche_share_above_vd",
+                 "theta_stop_se_deg", "delta_theta_mean_deg", "delta_theta_se_deg",
+                 "theta_start_centroid_mean_deg", "theta_start_centroid_se_deg", "theta_stop_centroid_mean_deg",
+                 "theta_stop_centroid_se_deg", "delta_theta_centroid_mean_deg", "delta_theta_centroid_se_deg",
+                 "avalanche_share_above_vd",
                  "avalanche_share_above_vstar", "avalanche_slip_fs_fn", "wall_time_s")
 
 
@@ -190,7 +198,7 @@ def write_results(jobs, out):
     for label, sc, _, folder in jobs:
         run_summary, slope = load_run(folder)
         # measured again from the slope series: the figures follow kinds/drum.py as it is now
-        summary = dict(run_summary, **drum.summarise(sc, slope, slope["theta_deg"].to_numpy()))
+        summary = dict(run_summary, **drum.summarise(sc, slope, slope["theta_deg"], slope["theta_centroid_deg"]))
         c = sc.contact
         row = {"label": label, "mu_s": c.mu_s, "mu_k": c.mu_k, "nu_s": c.nu_s, "reset": c.reset,
                "slip_timing": c.slip_timing, "rate_rad_s": abs(sc.gravity_rate), "dt_s": sc.dt,
@@ -198,7 +206,7 @@ def write_results(jobs, out):
         row.update({k: summary.get(k, math.nan) for k in STUDY_COLUMNS if k not in row})
         rows.append(row)
         for e in summary["avalanche_list"]:
-            events.append({"label": label, **e, "avalanche": e["delta_theta"] >= drum.MIN_DROP})
+            events.append({"label": label, **e})
     study = pd.DataFrame(rows, columns=STUDY_COLUMNS)
     study.to_csv(out / "study.csv", index=False)
     pd.DataFrame(events).to_csv(out / "avalanches.csv", index=False)
@@ -216,16 +224,18 @@ def _table(study, figs):
     lines = ["# Drum study: the table", "",
              "Written by `stickslip drum-study` (stickslip/drum_study.py); the findings: [../drum.md](../drum.md). "
              "Means over the avalanches of each run with their standard errors (std / sqrt(n)); angles in degrees.",
-             "", "| run | μs | μk | νs | reset | timing | rate (rad/s) | dt (s) | avalanches (slides) | θ_start | θ_stop "
-             "| δθ | slipping above V_d | above V* | ⟨abs(Fs)/Fn⟩ slipping |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "θ: fit to the middle of the surface; θc: the centroid's angle (stickslip/kinds/drum.py).", "",
+             "| run | μs | μk | νs | reset | timing | rate (rad/s) | dt (s) | avalanches (slides) | θ_start | θ_stop "
+             "| δθ | θc_start | θc_stop | δθc | slipping above V_d | above V* | ⟨abs(Fs)/Fn⟩ slipping |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in study.iterrows():
+        angles = " | ".join(pm(r[f"{k}_mean_deg"], r[f"{k}_se_deg"])
+                            for k in ("theta_start", "theta_stop", "delta_theta", "theta_start_centroid",
+                                      "theta_stop_centroid", "delta_theta_centroid"))
         lines.append(f"| {r.label} | {r.mu_s:g} | {r.mu_k:g} | {r.nu_s:g} | {r.reset} | {r.slip_timing} | "
-                     f"{r.rate_rad_s:g} | {r.dt_s:g} | {int(r.avalanches)} ({int(r.slides)}) | "
-                     f"{pm(r.theta_start_mean_deg, r.theta_start_se_deg)} | "
-                     f"{pm(r.theta_stop_mean_deg, r.theta_stop_se_deg)} | "
-                     f"{pm(r.delta_theta_mean_deg, r.delta_theta_se_deg)} | {r.avalanche_share_above_vd:.2f} | "
-                     f"{r.avalanche_share_above_vstar:.2f} | {r.avalanche_slip_fs_fn:.3f} |")
+                     f"{r.rate_rad_s:g} | {r.dt_s:g} | {int(r.avalanches)} ({int(r.slides)}) | {angles} | "
+                     f"{r.avalanche_share_above_vd:.2f} | {r.avalanche_share_above_vstar:.2f} | "
+                     f"{r.avalanche_slip_fs_fn:.3f} |")
     lines += [""] + [f"![{f}]({f})" for f in figs] + [""]
     return "\n".join(lines)
 
@@ -244,11 +254,12 @@ def report_section(report_dir, docs=DOCS):
     study = pd.read_csv(docs / "study.csv")
     lines += [f"From the finished study in [{rel}/study.md]({rel}/study.md) ({len(study)} runs; the findings and the "
               f"calibration recipe: [{rel}/../drum.md]({rel}/../drum.md)). Means ± standard errors, degrees.", "",
-              "| run | avalanches | θ_start | θ_stop | δθ |", "|---|---|---|---|---|"]
+              "| run | avalanches | θ_start (fit) | θ_stop (fit) | θ_start (centroid) | θ_stop (centroid) |",
+              "|---|---|---|---|---|---|"]
     for _, r in study.iterrows():
-        lines.append(f"| {r.label} | {int(r.avalanches)} | {r.theta_start_mean_deg:.2f} ± {r.theta_start_se_deg:.2f} "
-                     f"| {r.theta_stop_mean_deg:.2f} ± {r.theta_stop_se_deg:.2f} | "
-                     f"{r.delta_theta_mean_deg:.2f} ± {r.delta_theta_se_deg:.2f} |")
+        lines.append(f"| {r.label} | {int(r.avalanches)} | " + " | ".join(
+            f"{r[f'{k}_mean_deg']:.2f} ± {r[f'{k}_se_deg']:.2f}"
+            for k in ("theta_start", "theta_stop", "theta_start_centroid", "theta_stop_centroid")) + " |")
     lines.append("")
     for png in sorted(docs.glob("drum_*.png")):
         lines += [f"![{png.stem}]({rel}/{png.name})", ""]

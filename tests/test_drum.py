@@ -178,7 +178,7 @@ def test_avalanches_are_found_in_the_kinetic_energy():
         ekin[on] = (1e-3 if drop > 1 else 2e-4) * scale
         theta[t > t1] -= drop
     df = pd.DataFrame({"t": t, "ekin": ekin, **{c: np.zeros(len(t)) for c in columns.SLIP_STATS}})
-    s = drum.summarise(sc, df, theta)
+    s = drum.summarise(sc, df, theta, theta)
     assert s["avalanches"] == 1 and s["slides"] == 1  # the burst at 2 s is before settle = 4 s
     a = s["avalanche_list"][0]
     assert a["theta_start"] == pytest.approx(20 + 7.99 - 5.0, abs=1e-9)

@@ -1,8 +1,13 @@
 """Kind "drum": avalanches in a slowly turning drum (cases/drum.toml, docs/drum.md).
 
-From the recorded grains at each row: the free surface's slope angle theta (degrees,
-positive on the side the turning steepens), from a straight-line fit to the pile's top
-over the middle 60 % of its width, in the frame of the gravity of that row. From the
+From the recorded grains at each row, two measures of the surface's slope (degrees,
+positive on the side the turning steepens, in the frame of the row's gravity): theta,
+a straight-line fit to the pile's top over the middle 60 % of its width (bins of one
+mean diameter, the highest grain top in each), and theta_centroid, the angle between
+gravity and the line from the drum's centre to the pile's centroid (a flat surface is
+perpendicular to it). The fit reads the middle of the surface, as an experiment's
+camera does, with ~1 deg of noise from which grain tops a bin; the centroid's angle
+averages the whole surface and is free of that noise. From the
 kinetic energy (output.stats): the avalanches (EKIN_QUIET, EKIN_AVALANCHE below), with
 theta_start the slope just before one starts to move and theta_stop just after it is
 quiet again. Their means, standard errors and the
@@ -31,9 +36,10 @@ REPORT_TIMINGS = ("step",)
 EKIN_QUIET = 1e-6
 EKIN_AVALANCHE = 1e-4
 MERGE_GAP = 0.05  # s
-# An event that lowers the slope by less than this (degrees) is a slide at the foot or
-# the top of the pile, not an avalanche of its surface: counted apart ("slides"). The
-# slope of a pile turning rigidly reads within ~0.05 deg of a straight ramp (the fit).
+# An event that lowers the centroid's angle by less than this (degrees) is a slide at the
+# foot or the top of the pile (a precursor), not an avalanche of its surface: counted
+# apart ("slides"). Between events the centroid's angle is a straight ramp to 1e-3 deg;
+# the drops of the avalanches measured are 5-25 deg, of the slides below 0.5 deg.
 MIN_DROP = 0.5
 # The fit: bins of one mean diameter across the pile, the middle 60 % of its width.
 FIT_MIDDLE = 0.6
@@ -127,16 +133,21 @@ def avalanches(scene, df):
             if a > 0 and t[a] >= settle and b + 1 < len(t) and e[a:b + 1].max() > EKIN_AVALANCHE]
 
 
-def measure(scene, df, theta=None):
-    """The theta series and the avalanche table (a dict per avalanche); `df` needs t, ekin
-    (and the slip statistics), and the grains only when theta is not given."""
-    theta = slope_angles(scene, df) if theta is None else theta
+def measure(scene, df, theta=None, theta_c=None):
+    """The fit's and the centroid's angle series and the table of events (a dict each);
+    `df` needs t, ekin (and the slip statistics), and the grains only when the angles are
+    not given."""
+    theta = slope_angles(scene, df) if theta is None else np.asarray(theta, float)
+    theta_c = centroid_angles(scene, df) if theta_c is None else np.asarray(theta_c, float)
     t = df["t"].to_numpy(float)
     rows = []
     for a, b in avalanches(scene, df):
-        row = {"t_onset": float(t[a]), "t_end": float(t[b + 1]), "theta_start": float(theta[a - 1]),
-               "theta_stop": float(theta[b + 1])}
-        row["delta_theta"] = row["theta_start"] - row["theta_stop"]
+        row = {"t_onset": float(t[a]), "t_end": float(t[b + 1])}
+        for key, series in (("", theta), ("_centroid", theta_c)):
+            row[f"theta_start{key}"], row[f"theta_stop{key}"] = float(series[a - 1]), float(series[b + 1])
+            row[f"delta_theta{key}"] = row[f"theta_start{key}"] - row[f"theta_stop{key}"]
+        # an avalanche lowers the pile as a whole; a slide at its foot or top barely moves its centroid
+        row["avalanche"] = row["delta_theta_centroid"] >= MIN_DROP
         if scene.output.slip_stats:
             seg = df.iloc[a:b + 1]
             n = float(seg["n_slipping"].sum())
@@ -145,7 +156,7 @@ def measure(scene, df, theta=None):
             row["share_above_vstar"] = float(seg["n_slip_above_vstar"].sum()) / n if n else math.nan
             row["slip_fs_fn"] = float(seg["slip_fs_fn_sum"].sum()) / n if n else math.nan
         rows.append(row)
-    return theta, rows
+    return theta, theta_c, rows
 
 
 def mean_se(values):
@@ -157,11 +168,14 @@ def mean_se(values):
     return float(v.mean()), float(v.std(ddof=1) / math.sqrt(len(v)))
 
 
-def summarise(scene, df, theta=None):
-    theta, events = measure(scene, df, theta)
-    rows = [r for r in events if r["delta_theta"] >= MIN_DROP]
+ANGLES = ("theta_start", "theta_stop", "delta_theta")
+
+
+def summarise(scene, df, theta=None, theta_c=None):
+    _, _, events = measure(scene, df, theta, theta_c)
+    rows = [r for r in events if r["avalanche"]]
     out = {"avalanches": len(rows), "slides": len(events) - len(rows), "energy_scale_J": energy_scale(scene)}
-    for key in ("theta_start", "theta_stop", "delta_theta"):
+    for key in ANGLES + tuple(f"{k}_centroid" for k in ANGLES):
         m, se = mean_se([r[key] for r in rows])
         out[f"{key}_mean_deg"], out[f"{key}_se_deg"] = m, se
     if scene.output.slip_stats and rows:
@@ -169,7 +183,7 @@ def summarise(scene, df, theta=None):
         for key in ("share_above_vd", "share_above_vstar", "slip_fs_fn"):
             total = sum(r[key] * r["slipping_contacts"] for r in rows if r["slipping_contacts"])
             out[f"avalanche_{key}"] = total / n if n else math.nan
-    out["avalanche_list"] = events  # slides included (delta_theta < MIN_DROP)
+    out["avalanche_list"] = events  # slides too ("avalanche": false)
     return out
 
 
@@ -189,11 +203,13 @@ def figures(out, runs):
 
     plt, names = pyplot(), []
     for key, (scene, summary, df) in runs.items():
-        theta, rows = measure(scene, df)
+        theta, theta_c, rows = measure(scene, df)
         fig, ax = plt.subplots(figsize=(8, 3))
-        ax.plot(df["t"], theta, lw=0.8)
+        ax.plot(df["t"], theta, lw=0.8, label="fit")
+        ax.plot(df["t"], theta_c, lw=0.8, label="centroid")
+        ax.legend()
         for r in rows:
-            ax.axvspan(r["t_onset"], r["t_end"], color="0.85")
+            ax.axvspan(r["t_onset"], r["t_end"], color="0.85" if r["avalanche"] else "0.95")
         ax.set_xlabel("t (s)")
         ax.set_ylabel("surface slope (deg)")
         ax.set_title(" ".join(str(k) for k in key))
