@@ -283,7 +283,7 @@ class Simulation:
     def slip_statistics(self):
         """The row's columns.SLIP_STATS over grain-grain contacts (docs in columns.py)."""
         c, p = self.contacts, self.p
-        sel = c.slipped & (c.j < self.N)
+        sel = c.slipped & (c.j < self.N) & (c.fn > 0)  # no normal force: no friction to count
         fn, vs = c.fn[sel], self.vs_mag[sel]
         drop = 2.0 * (p.mu_s - p.mu_k) * fn  # the force a stick phase must climb after a slip
         above_vd = vs * p.nu_s >= drop  # |V_s| >= V_d, written without dividing by nu_s = 0

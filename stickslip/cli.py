@@ -99,7 +99,7 @@ def build_parser():
     ds.add_argument("--runs", type=_folder, default=Path("runs/drum_study"),
                     help="the runs, kept for resuming (default: runs/drum_study)")
     ds.add_argument("--rate", type=_positive, help="drum rate, rad/s (default: the scene's)")
-    ds.add_argument("--duration", type=_positive, default=60.0, help="simulated time per run, s (default: 60)")
+    ds.add_argument("--duration", type=_positive, default=75.0, help="simulated time per run, s (default: 75)")
     ds.add_argument("--fill", type=_positive, help="share of the drum filled (default: the scene's grain count)")
     ds.add_argument("--seed", type=int, help="the fill's random seed (default: the scene's)")
     ds.add_argument("--only", nargs="+", help="run only these runs of the matrix (labels)")

@@ -10,8 +10,8 @@ from __future__ import annotations
 # (of which the tangential law's slips and dashpot), work of gravity and of the drive.
 ENERGY = ("e_kin", "e_elastic", "e_dissipated", "e_slip", "e_dashpot", "w_gravity", "w_drive")
 STATS = ("n_contacts", "ekin")
-# Slip statistics with output.slip_stats, over the grain-grain contacts touching at the row
-# (wall contacts are not counted): how many slipped in the row's step, how many of those
+# Slip statistics with output.slip_stats, over the grain-grain contacts pressed together
+# at the row (Fn > 0; wall contacts are not counted): how many slipped in the row's step, how many of those
 # slide (|V_s|) at or above the dashpot threshold V_d = 2(mu_s - mu_k) Fn / nu_s and above
 # V* = 2(mu_s - mu_k) Fn / (nu_s + Ks dt) (docs/law.md: above them every step slips; nu_s
 # = 0: V_d is infinite), and the sum of |Fs|/Fn over those (its mean: / n_slipping).

@@ -28,7 +28,7 @@ REPORT_TIMINGS = ("step",)
 
 # Avalanches are found in the kinetic energy E (output.stats), in units of M g d (M the
 # moving grains' mass, d their mean diameter). A pile turning rigidly with the drum at
-# 0.02 rad/s has E ~ 1e-9 of it; precursor rearrangements reach 1e-7 to 1e-5, avalanches
+# 0.03 rad/s has E ~ 1e-9 of it; precursor rearrangements reach 1e-7 to 1e-5, avalanches
 # 1e-3 and more. An event is a run of rows with E above EKIN_QUIET (rows less than
 # MERGE_GAP apart joined); it is an avalanche when its E exceeds EKIN_AVALANCHE.
 # theta_start is theta at the last quiet row before it, theta_stop at the first quiet
