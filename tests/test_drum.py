@@ -240,3 +240,33 @@ def test_drum_study_refuses_bad_settings_in_one_line(args, words, tmp_path, caps
     for w in words:
         assert w in err, (w, err)
     assert not (tmp_path / "runs").exists()
+
+
+# ---------------------------------------------------------------- the study's smoke version
+
+@needs_liggghts
+def test_drum_study_smoke(tmp_path):
+    """The study's code path on the small drum (cases/drum_small.toml: 80 disks), history
+    mu = 0.5 against stick-slip 0.5/0.35 (step timing), 20 s each on one LIGGGHTS rank
+    (~20 s each on an idle core). What this size can show:
+    - the drum turns and avalanches happen, in both (the spin-up's is not counted);
+    - in an avalanche every slipping grain-grain contact carries exactly mu Fn (history)
+      and exactly Fmin = (2 mu_k - mu_s) Fn = 0.2 Fn (stick-slip, step timing: the force
+      is set to Fmin at each slip, eq. 8), the mechanism behind the study's finding;
+    - a study resumes: a second call runs nothing and writes the same table."""
+    from stickslip.drum_study import SMOKE_LABELS, run_study
+
+    kw = dict(out=tmp_path / "out", out_runs=tmp_path / "runs", rate=0.03, duration=20.0, labels=SMOKE_LABELS,
+              full=False, ranks=1, progress=False)
+    study = run_study(scene_mod.find("drum_small"), **kw).set_index("label")
+    assert set(study.index) == set(SMOKE_LABELS)
+    for label in SMOKE_LABELS:
+        assert study.loc[label, "avalanches"] >= 1, label
+    assert study.loc["history_mu0.50", "avalanche_slip_fs_fn"] == pytest.approx(0.5, abs=1e-9)
+    assert study.loc["ss_0.50_0.35_step", "avalanche_slip_fs_fn"] == pytest.approx(0.2, abs=1e-9)
+    stamp = {p: p.stat().st_mtime_ns for p in (tmp_path / "runs").rglob("summary.json")}
+    again = run_study(scene_mod.find("drum_small"), **kw).set_index("label")
+    assert {p: p.stat().st_mtime_ns for p in (tmp_path / "runs").rglob("summary.json")} == stamp
+    pd.testing.assert_frame_equal(again, study)
+    for png in ("drum_calibration.png", "drum_traces.png"):
+        assert (tmp_path / "out" / png).stat().st_size > 10_000

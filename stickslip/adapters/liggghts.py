@@ -404,9 +404,12 @@ def _slip_stats(script, atoms, slips, steps):
             continue
         i, j = blk[:, 0].astype(int), blk[:, 1].astype(int)
         prev = slips.get(s - 1, np.zeros((0, 8)))
-        before = dict(zip(zip(prev[:, 0].astype(int), prev[:, 1].astype(int)), prev[:, 7]))
+        # a pair is keyed by its two ids in either order: a neighbour-list rebuild may swap them
+        pi, pj = prev[:, 0].astype(int), prev[:, 1].astype(int)
+        before = dict(zip(zip(np.minimum(pi, pj), np.maximum(pi, pj)), prev[:, 7]))
         count = blk[:, 7]
-        sel = (count != np.array([before.get((a, b), 0.0) for a, b in zip(i, j)])) & (count > 0) & (blk[:, 3] > 0)
+        was = np.array([before.get((min(a, b), max(a, b)), 0.0) for a, b in zip(i, j)])
+        sel = (count != was) & (count > 0) & (blk[:, 3] > 0)
         a = atoms[s]
         at = {int(k): r for r, k in enumerate(a[:, 0])}
         ai, aj = a[[at[k] for k in i[sel]]], a[[at[k] for k in j[sel]]]
