@@ -105,6 +105,8 @@ def build_parser():
     ds.add_argument("--only", nargs="+", help="run only these runs of the matrix (labels)")
     ds.add_argument("--no-checks", action="store_true", help="leave out the half-rate and half-dt runs")
     ds.add_argument("--ranks", type=_count, default=os.cpu_count() or 1, help="MPI ranks (default: every core)")
+    ds.add_argument("--costs", nargs="+", choices=ENGINES, metavar="ENGINE",
+                    help="instead of the study: each engine's cost on the drum (0.3 s side by side) -> costs.csv")
     ds.add_argument("--tables-only", action="store_true",
                     help="write the tables and figures of the runs finished so far; run nothing")
     ds.add_argument("--keep-timeseries", action="store_true", help="keep each run's full time series (~100 MB)")
@@ -214,6 +216,11 @@ def cmd_drum_study(args):
 
     from .drum_study import run_study
 
+    if args.costs:
+        from .drum_study import engine_costs
+
+        print(engine_costs(args.out, args.costs, progress=not args.quiet).to_string(index=False))
+        return 0
     path = scene_mod.find(args.scene)
     rate = args.rate or abs(tomllib.loads(path.read_text()).get("gravity_rate", 0.0)) or None
     if rate is None:

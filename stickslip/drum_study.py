@@ -264,3 +264,28 @@ def report_section(report_dir, docs=DOCS):
     for png in sorted(docs.glob("drum_*.png")):
         lines += [f"![{png.stem}]({rel}/{png.name})", ""]
     return "\n".join(lines)
+
+
+def engine_costs(out, engines, duration=0.3, progress=False):
+    """Each engine's cost on the drum: the first `duration` s of cases/drum.toml (the fill
+    falls and packs: ~350 contacts), run side by side in one call; grain-steps per second
+    of the engine's own loop (RunResult.wall_time_s) and, for LIGGGHTS, on 1 and 2 ranks.
+    Written to costs.csv."""
+    from .scene import load
+
+    sc = load("drum", duration=duration, every=1000)
+    rows = []
+    for engine, ranks in [(e, 1) for e in engines] + ([("liggghts", 2)] if "liggghts" in engines else []):
+        summary, _ = runner.run_scene(sc, engine, Path(out) / "costs" / f"{engine}_{ranks}", progress=progress,
+                                      ranks=ranks)
+        rows.append({"engine": engine, "ranks": ranks, "steps": summary["steps"], "grains": len(sc.grains),
+                     "wall_time_s": summary["wall_time_s"],
+                     "grain_steps_per_s": summary["steps"] * len(sc.grains) / summary["wall_time_s"]})
+    table = pd.DataFrame(rows)
+    one = table[(table.engine == "liggghts") & (table.ranks == 1)]
+    two = table[(table.engine == "liggghts") & (table.ranks == 2)]
+    if len(one) and len(two):
+        table.loc[two.index, "speedup_vs_1_rank"] = float(one.wall_time_s.iloc[0] / two.wall_time_s.iloc[0])
+    Path(out).mkdir(parents=True, exist_ok=True)
+    table.to_csv(Path(out) / "costs.csv", index=False)
+    return table
