@@ -28,7 +28,7 @@ from .scene import find, parse
 
 # Stock history is stick_slip with mu_k = mu_s and no tangential damping (the slip then
 # drops the force to mu Fn and leaves it there: a cap, as history's; docs/law.md).
-HISTORY_MUS = (0.5, 0.45, 0.4, 0.3, 0.2)
+HISTORY_MUS = (0.5, 0.45, 0.4, 0.3, 0.2, 0.15, 0.1)
 PAPER_NU_S = 33.10
 
 
@@ -55,9 +55,10 @@ def matrix(rate, full=True):
 
 SMOKE_LABELS = ("history_mu0.50", "ss_0.50_0.35_step")
 
-# LIGGGHTS' speed on this scene, grain-steps per second (2 ranks on the 2-core machine:
-# 4.3e8 grain-steps in 24.6 s; 1 rank about half): only to say beforehand what a study costs.
-SPEED = {1: 9e6, 2: 1.7e7}
+# LIGGGHTS' speed on this scene, grain-steps per second with the dumps read back (2 ranks
+# on the 2-core machine: 2.0e9 grain-steps in 200 s a run, the engine itself 1.75e7/s;
+# 1 rank about half): only to say beforehand what a study costs.
+SPEED = {1: 5e6, 2: 1.0e7}
 # The avalanche regime: the drum turns by at most MAX_TURN_PER_AVALANCHE (rad) while an
 # avalanche runs, which lasts ~5 sqrt(D/g) (0.4-1.2 s measured in this drum, D = 88 mm).
 MAX_TURN_PER_AVALANCHE = math.radians(1.0)
