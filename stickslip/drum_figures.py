@@ -48,7 +48,7 @@ def draw(out, study, events, folders):
     names.append(save(fig, out, "drum_calibration.png"))
 
     if len(events):
-        shown = [lab for lab in ("history_mu0.50", "ss_0.50_0.45_step", "ss_0.50_0.45_exact", "ss_0.50_0.35_step")
+        shown = [lab for lab in ("history_mu0.50", "history_mu0.20", "ss_0.50_0.45_step", "ss_0.50_0.35_step")
                  if lab in set(events.label)]
         fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
         av = events[events.avalanche.astype(bool)]

@@ -43,6 +43,8 @@ def matrix(rate, full=True):
         ("ss_0.50_0.45_total_step", dict(ss, reset="total", slip_timing="step"), rate, 1, 1),
         ("ss_0.50_0.35_step", dict(ss, mu_k=0.35, slip_timing="step"), rate, 1, 1),
         ("ss_0.50_0.35_exact", dict(ss, mu_k=0.35, slip_timing="exact"), rate, 1, 1),
+        # Fmin = 0.1 Fn against mu_k = 0.3: where history's angles differ most between the two
+        ("ss_0.50_0.30_step", dict(ss, mu_k=0.30, slip_timing="step"), rate, 1, 1),
     ]
     if full:  # the checks of the setting: the rate halved, the step halved
         runs += [
