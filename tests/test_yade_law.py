@@ -244,7 +244,7 @@ def test_3d_sphere_contact_replays_through_pyref_law(tmp_path, reset):
     # rotation on). Each step's kinematics, as YADE had them when the law ran, are fed to
     # pyref's law functions (an independent implementation of docs/law.md): Fn, F_s and the
     # slip flag must agree to round-off, the spring being turned as the normal turns. The
-    # ball's spin change checks the torque: dw = dt * (r n x F_s) / I (no other torque).
+    # ball's spin change checks the torque: dw = dt * (c n x F_s) / I, c = r - delta/2 (no other torque).
     P = [1e5, 1.0, 8e4, 0.5, 0.5, 0.45, 0.005, 1e-5, 2000, reset]
     script = tmp_path / "replay.py"
     script.write_text(REPLAY % (str(LAW), P))
@@ -267,7 +267,8 @@ def test_3d_sphere_contact_replays_through_pyref_law(tmp_path, reset):
             continue
         touching += 1
         turn = max(turn, math.degrees(math.acos(min(1.0, n @ n0))))
-        v_rel = (a[3:6] + np.cross(a[6:9], r * n)) - (b[3:6] + np.cross(b[6:9], -r * n))
+        c = r - 0.5 * (2 * r - dist)  # lever arm to the contact point midway in the overlap (docs/law.md)
+        v_rel = (a[3:6] + np.cross(a[6:9], c * n)) - (b[3:6] + np.cross(b[6:9], -c * n))
         v_n = v_rel @ n
         fn = normal_force(np.array([2 * r - dist]), np.array([v_n]), law)
         D = rotate_history(D, n[None])
@@ -278,7 +279,7 @@ def test_3d_sphere_contact_replays_through_pyref_law(tmp_path, reset):
         assert got[2] == bool(slipped[0]), k
         if k + 1 < len(log):
             dw = np.array(log[k + 1][0][1][6:9]) - b[6:9]
-            expect = dt * np.cross(r * n, F[0]) / inertia
+            expect = dt * np.cross(c * n, F[0]) / inertia
             assert np.abs(dw - expect).max() <= dt * r * scale / inertia + 1e-12, k
     # The run must exercise what it claims: long contact, sticks and slips, a turning normal.
     assert touching > 1000 and 10 < slips < touching - 100 and turn > 3.0

@@ -362,7 +362,8 @@ def test_periodic_homogeneous_shear_loads_the_spring_with_the_image_motion(tmp_p
         d = img - xa
         n = d / np.linalg.norm(d)
         if prev is not None:
-            step_rel = (xa - prev[0]) - (img - prev[1]) + dt * np.cross(r * wa + r * wb, n)
+            c = r - 0.5 * (2 * r - np.linalg.norm(d))  # lever arm to mid-overlap (docs/law.md step 1)
+            step_rel = (xa - prev[0]) - (img - prev[1]) + dt * np.cross(c * wa + c * wb, n)
             if D.any():  # turned into the tangent plane keeping its length (docs/law.md step 3)
                 L = np.linalg.norm(D)
                 D = D - (D @ n) * n

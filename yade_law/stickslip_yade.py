@@ -404,9 +404,10 @@ class StickSlipLaw:
         # periodic boundary id2's image also moves with the cell; tangential part (eq. 6).
         v_rel = V[i1] - V[i2]
         ss, other = geo["ss"], geo["other"]
-        if self.rotation and not len(other) == len(i1):  # w1 x a1 - w2 x a2 = (r1 w1 + r2 w2) x n for sphere pairs
-            rW = self.radius[:, None] * W  # per body: fewer rows than contacts
-            v_rel += _cross(rW[i1] + rW[i2], n)
+        if self.rotation and not len(other) == len(i1):  # w1 x a1 - w2 x a2 = (c1 w1 + c2 w2) x n for sphere pairs
+            # lever arms c = r - delta/2 to the contact point midway in the overlap (docs/law.md)
+            half = 0.5 * delta[:, None]
+            v_rel += _cross((self.radius[i1][:, None] - half) * W[i1] + (self.radius[i2][:, None] - half) * W[i2], n)
         if len(other):  # lever arms to YADE's contact point; walls and facets may turn
             o1, o2 = i1[other], i2[other]
             vo = V[o1] - V[o2]
@@ -452,7 +453,7 @@ class StickSlipLaw:
         self.count = self.count + tan.slipped
         if energy:
             self._energy(O, tan, self.kn, delta, fn, v_n, dt)
-        self._apply(O, i1, i2, F_s, n, a1, a2, other)
+        self._apply(O, i1, i2, F_s, n, a1, a2, other, delta)
 
     def _cell(self, O):
         """Periodic cell: (hSize, velGrad @ prevHSize), so that id2's image across the boundary
@@ -621,17 +622,17 @@ class StickSlipLaw:
         return out
 
     def _assemble(self, idx, d, dist, delta, other, g):
-        """Per-contact geometry: sphere pairs from the recomputed distance (lever arms: the
-        radii along the normal, docs/law.md step 1), the others from YADE's."""
+        """Per-contact geometry: sphere pairs from the recomputed distance (lever arms r - delta/2
+        along the normal, docs/law.md step 1), the others from YADE's."""
         i1, i2, ss, _, r1, r2, _ = idx
         if len(other) and len(other) == len(i1):  # no sphere pair
             return {"i1": i1, "i2": i2, "ss": ss, "n": g["n"], "delta": g["delta"], "a1": g["a1"], "a2": g["a2"],
                     "fn": g["fn"], "other": np.asarray(other, np.int64)}
         n = d / (dist if len(dist) and dist.min() > 0 else np.where(dist > 0, dist, 1.0))[:, None]
         fn = np.zeros(len(i1))
-        a1 = a2 = None  # sphere pairs need no arrays of lever arms (r1 n, -r2 n: see _step, _apply)
+        a1 = a2 = None  # sphere pairs need no arrays of lever arms (c1 n, -c2 n: see _step, _apply)
         if len(other):
-            a1, a2 = r1[:, None] * n, -r2[:, None] * n
+            a1, a2 = (r1 - 0.5 * delta)[:, None] * n, -(r2 - 0.5 * delta)[:, None] * n
             n[other], delta[other], fn[other] = g["n"], g["delta"], g["fn"]
             a1[other], a2[other] = g["a1"], g["a2"]
         return {"i1": i1, "i2": i2, "ss": ss, "n": n, "delta": delta, "a1": a1, "a2": a2, "fn": fn,
@@ -664,12 +665,15 @@ class StickSlipLaw:
         x2 = P[i2]
         if shift is not None:
             x2 = x2 + (self.cell[other] if cell is None else cell[other]) @ shift[0].T
+        half = 0.5 * A[:, 6]  # a sphere's lever arm reaches midway into the overlap (docs/law.md)
         return {"broken": broken, "n": n, "delta": A[:, 6], "fn": A[:, 7],
-                "a1": self._arm(self.sphere[i1], r1, n, c - P[i1]), "a2": self._arm(self.sphere[i2], -r2, n, c - x2)}
+                "a1": self._arm(self.sphere[i1], r1 - half, n, c - P[i1]),
+                "a2": self._arm(self.sphere[i2], -(r2 - half), n, c - x2)}
 
     @staticmethod
     def _arm(sphere, r, n, to_point):
-        """Lever arm: r*n for a sphere (docs/law.md step 1), else centre -> contact point."""
+        """Lever arm: r*n for a sphere (r: its radius less half the overlap, docs/law.md step 1),
+        else centre -> contact point."""
         if not sphere.any():
             return to_point
         if sphere.all():
@@ -721,7 +725,7 @@ class StickSlipLaw:
                            f"contacts (Ig2_{shape}_Sphere_ScGeom): spheres would pass through it")
         self._engines = list(engines)
 
-    def _apply(self, O, i1, i2, F_s, n, a1, a2, other):
+    def _apply(self, O, i1, i2, F_s, n, a1, a2, other, delta):
         """Forces and torques summed per body, then one addF (and addT) per body that gets any."""
         nb = self.nbodies
         F = np.empty((nb, 3))
@@ -731,9 +735,11 @@ class StickSlipLaw:
             got = np.flatnonzero(F.any(axis=1))
             list(map(O.forces.addF, got.tolist(), F[got].tolist(), repeat(False)))
             return
-        # Torques a1 x F_s on id1 and a2 x (-F_s) on id2; for sphere pairs r1 (n x F_s), r2 (n x F_s).
+        # Torques a1 x F_s on id1 and a2 x (-F_s) on id2; for sphere pairs c1 (n x F_s), c2 (n x F_s),
+        # c = r - delta/2 (docs/law.md step 6).
         nF = _cross(n, F_s)
-        t1, t2 = self.radius[i1][:, None] * nF, self.radius[i2][:, None] * nF
+        t1 = (self.radius[i1] - 0.5 * delta)[:, None] * nF
+        t2 = (self.radius[i2] - 0.5 * delta)[:, None] * nF
         if len(other):
             t1[other] = _cross(a1[other], F_s[other])
             t2[other] = -_cross(a2[other], F_s[other])
