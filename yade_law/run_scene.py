@@ -50,6 +50,8 @@ def build(sc):
         b.state.mass = g["mass"]
         b.state.inertia = Vector3(g["inertia"], g["inertia"], g["inertia"])
         blocked = "".join(g["imposed"])
+        if g.get("fixed"):  # held where it starts, no velocity, no spin
+            blocked += "xyzXYZ"
         if sc["dimension"] == 2:
             blocked += "zXY"  # motion in the xy-plane, rotation about z only
         if not eff["rotation"]:
@@ -71,6 +73,45 @@ def build(sc):
                                   rotation=eff["rotation"], extra=[e for e, _, _ in rotators])
     O.dt = sc["dt"]
     return ids, rotators
+
+
+def gravity_at(sc, t):
+    """The scene's gravity turned about z by its angle at t (stickslip Scene.gravity_angle:
+    the same arithmetic)."""
+    g = sc["gravity"]
+    rate0, t0 = sc.get("gravity_spinup", (0.0, 0.0))
+    rate = sc.get("gravity_rate", 0.0)
+    a = rate0 * t + (rate - rate0) * (t - t0) if t > t0 else rate0 * t
+    c, s = math.cos(a), math.sin(a)
+    return Vector3(c * g[0] - s * g[1], s * g[0] + c * g[1], g[2])
+
+
+def slip_stats(sc, law, kin, walls):
+    """columns.SLIP_STATS of the step just made, from the law's arrays and the kinematics
+    the law saw in it (`kin`: positions, velocities, spins of every body before the step):
+    grain-grain contacts pressed together that slipped, those sliding at or above V_d and
+    V*, and their summed |Fs|/Fn (stickslip/columns.py)."""
+    import numpy as np
+
+    c = sc["contact"]
+    if not len(law.keys):
+        return [0, 0, 0, 0.0]
+    i1, i2 = law.keys >> 32, law.keys & 0xFFFFFFFF
+    sel = law.slipped & (law.fn > 0) & ~np.isin(i1, walls) & ~np.isin(i2, walls)
+    i1, i2 = i1[sel], i2[sel]
+    x, v, w, r = kin
+    d = x[i2] - x[i1]
+    dist = np.linalg.norm(d, axis=1)
+    n = d / dist[:, None]
+    half = 0.5 * (r[i1] + r[i2] - dist)
+    v_rel = v[i1] - v[i2] + np.cross((r[i1] - half)[:, None] * w[i1] + (r[i2] - half)[:, None] * w[i2], n)
+    vs = np.linalg.norm(v_rel - np.sum(v_rel * n, axis=1)[:, None] * n, axis=1)
+    fn = law.fn[sel]
+    nu_s = c["nu_s"] if sc["effects"]["tangential_damping"] else 0.0
+    drop = 2.0 * (c["mu_s"] - c["mu_k"]) * fn
+    ratio = np.linalg.norm(law.F_s[sel], axis=1) / fn
+    return [int(sel.sum()), int(np.sum(vs * nu_s >= drop)), int(np.sum(vs * (nu_s + c["ks"] * sc["dt"]) >= drop)),
+            float(ratio.sum())]
 
 
 def main(scene_path, out_path):
@@ -112,7 +153,23 @@ def main(scene_path, out_path):
         if out["stats"]:
             ek = sum(0.5 * b.state.mass * b.state.vel.squaredNorm() for b in O.bodies if b.dynamic)
             r += [len(law.keys), ek]
+        if out.get("slip_stats"):
+            r += slip_stats(sc, law, kin_before, wall_ids) if step else [0, 0, 0, 0.0]
         return r
+
+    import numpy as np
+
+    wall_ids = np.array([ids[w["name"]] for w in sc["walls"]], np.int64)
+    radius = np.array([b.shape.radius if hasattr(b.shape, "radius") else 0.0 for b in O.bodies])
+    kin_before = None
+
+    def kinematics():
+        st = [b.state for b in O.bodies]
+        return (np.array([s.pos.__getinitargs__() for s in st]), np.array([s.vel.__getinitargs__() for s in st]),
+                np.array([s.angVel.__getinitargs__() for s in st]), radius)
+
+    turning = sc.get("gravity_rate", 0.0) or sc.get("gravity_spinup", (0.0, 0.0))[1]
+    newton = next((e for e in O.engines if type(e).__name__ == "NewtonIntegrator"), None)
 
     rows = [row(0)]
     if len(rows[0]) != len(header):
@@ -120,6 +177,10 @@ def main(scene_path, out_path):
     stop_at = {n: (eng, bid) for eng, bid, n in rotators}
     t0 = time.perf_counter()
     for step in range(1, steps + 1):
+        if turning and sc["effects"]["gravity"]:  # the gravity of the positions this step's forces act on
+            newton.gravity = gravity_at(sc, (step - 1) * O.dt)
+        if out.get("slip_stats") and step % every == 0:
+            kin_before = kinematics()
         O.step()
         for k, (key, _) in enumerate(pairs):
             got = last[k] = law.lookup(*key)

@@ -50,11 +50,12 @@ def scene_dict(scene):
         "grains": [{"name": g.name, "radius": g.radius, "mass": scene.grain_mass(g),
                     "inertia": scene.grain_inertia(g), "position": v(g.position), "velocity": v(g.velocity),
                     "angular_velocity": [float(c) for c in g.angular_velocity],
-                    "imposed": list(g.imposed)} for g in scene.grains],
+                    "imposed": list(g.imposed), "fixed": g.fixed} for g in scene.grains],
+        "gravity_rate": scene.gravity_rate, "gravity_spinup": list(scene.gravity_spinup),
         "walls": walls,
         "columns": columns.names(scene),
         "output": {"grains": scene.output.grains, "contacts": scene.output.contacts, "walls": scene.output.walls,
-                   "stats": scene.output.stats},
+                   "stats": scene.output.stats, "slip_stats": scene.output.slip_stats},
     }
 
 
