@@ -26,17 +26,27 @@ setup_system() {
 }
 
 setup_python() {
+    # Install only when the environment is new or the project's dependencies changed
+    # (pyproject.toml's hash is kept in .venv): a set-up that has nothing to do costs nothing.
+    local stamp=.venv/.stickslip-pyproject.sha256
+    local want
+    want="$(sha256sum pyproject.toml | cut -d' ' -f1)"
     if [ ! -x .venv/bin/python ]; then
         python3 -m venv .venv
     fi
-    .venv/bin/python -m pip install -q --upgrade pip >/dev/null
-    .venv/bin/python -m pip install -q -e '.[test]'
+    if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ] || ! .venv/bin/python -c "import stickslip" 2>/dev/null; then
+        .venv/bin/python -m pip install -q --upgrade pip >/dev/null
+        .venv/bin/python -m pip install -q -e '.[test]'
+        echo "$want" > "$stamp"
+    fi
 }
 
 setup_plugin() {
-    # The LIGGGHTS plugin builds in seconds against the installed headers.
+    # The LIGGGHTS plugin builds in seconds against the installed headers; cmake rebuilds
+    # only what changed, so a second set-up is a second or so.
     if [ -f liggghts_plugin/CMakeLists.txt ] && command -v liggghts >/dev/null 2>&1; then
-        cmake -S liggghts_plugin -B build/liggghts_plugin -DCMAKE_BUILD_TYPE=Release >/dev/null
+        [ -f build/liggghts_plugin/CMakeCache.txt ] || \
+            cmake -S liggghts_plugin -B build/liggghts_plugin -DCMAKE_BUILD_TYPE=Release >/dev/null
         cmake --build build/liggghts_plugin -j 2 >/dev/null
     fi
 }
