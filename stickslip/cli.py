@@ -1,7 +1,8 @@
 """The `stickslip` command: parses its arguments and calls the module that does the work.
 
 run -> runner.py, precision -> precision.py, thresholds -> thresholds.py,
-bench -> bench.py, report -> report.py, drum-study -> drum_study.py. Bad arguments or a bad scene: one line on
+bench -> bench.py, report -> report.py, drum-study -> drum_study.py, drum-engines ->
+drum_engines.py. Bad arguments or a bad scene: one line on
 stderr, exit status 2; an engine that fails, a file that cannot be written, or a fault of
 ours: one line, exit status 1 (STICKSLIP_TRACEBACK=1 shows the traceback of a fault).
 """
@@ -105,12 +106,24 @@ def build_parser():
     ds.add_argument("--only", nargs="+", help="run only these runs of the matrix (labels)")
     ds.add_argument("--no-checks", action="store_true", help="leave out the half-rate and half-dt runs")
     ds.add_argument("--ranks", type=_count, default=os.cpu_count() or 1, help="MPI ranks (default: every core)")
-    ds.add_argument("--costs", nargs="+", choices=ENGINES, metavar="ENGINE",
-                    help="instead of the study: each engine's cost on the drum (0.3 s side by side) -> costs.csv")
     ds.add_argument("--tables-only", action="store_true",
                     help="write the tables and figures of the runs finished so far; run nothing")
-    ds.add_argument("--keep-timeseries", action="store_true", help="keep each run's full time series (~100 MB)")
+    ds.add_argument("--keep-timeseries", action="store_true",
+                    help="keep each run's full time series and engine files (gigabytes a run)")
     ds.add_argument("--quiet", action="store_true", help="no progress bars")
+
+    de = sub.add_parser("drum-engines", help="the drum across engines: costs, how long trajectories agree, "
+                                             "avalanche statistics of LIGGGHTS and YADE (docs/drum.md)")
+    de.add_argument("--out", type=_folder, default=Path("docs/drum"), help="tables and figures (default: docs/drum)")
+    de.add_argument("--runs", type=_folder, default=Path("runs/drum_study"),
+                    help="the runs, kept for resuming (default: runs/drum_study)")
+    de.add_argument("--engines", nargs="+", choices=ENGINES, default=list(ENGINES),
+                    help="engines to compare (default: all)")
+    de.add_argument("--duration", type=_positive, default=40.0,
+                    help="simulated time of the statistics runs, s (default: 40)")
+    de.add_argument("--parts", nargs="+", choices=("costs", "divergence", "statistics"),
+                    default=["costs", "divergence", "statistics"], help="which parts to run (default: all)")
+    de.add_argument("--quiet", action="store_true", help="no progress bars")
 
     rep = sub.add_parser("report", help="run the paper's cases on every available engine; figures + report.md")
     rep.add_argument("--out", type=_folder, default=Path("report"), help="output folder (default: report)")
@@ -216,11 +229,6 @@ def cmd_drum_study(args):
 
     from .drum_study import run_study
 
-    if args.costs:
-        from .drum_study import engine_costs
-
-        print(engine_costs(args.out, args.costs, progress=not args.quiet).to_string(index=False))
-        return 0
     path = scene_mod.find(args.scene)
     rate = args.rate or abs(tomllib.loads(path.read_text()).get("gravity_rate", 0.0)) or None
     if rate is None:
@@ -228,6 +236,13 @@ def cmd_drum_study(args):
     run_study(path, args.out, args.runs, rate, args.duration, fill=args.fill, seed=args.seed, labels=args.only,
               full=not args.no_checks, ranks=args.ranks, keep_timeseries=args.keep_timeseries,
               progress=not args.quiet, tables_only=args.tables_only)
+    return 0
+
+
+def cmd_drum_engines(args):
+    from . import drum_engines
+
+    drum_engines.run(args.out, args.runs, args.engines, args.duration, args.parts, progress=not args.quiet)
     return 0
 
 
@@ -240,7 +255,8 @@ def cmd_report(args):
 
 
 COMMANDS = {"run": cmd_run, "precision": cmd_precision, "thresholds": cmd_thresholds, "bench": cmd_bench,
-            "report": cmd_report, "drum-study": cmd_drum_study}
+            "report": cmd_report, "drum-study": cmd_drum_study,
+            "drum-engines": cmd_drum_engines}
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -21,14 +21,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import runner
+from . import drum_figures, runner
 from .errors import SceneError
 from .kinds import drum
 from .scene import find, parse
 
 # Stock history is stick_slip with mu_k = mu_s and no tangential damping (the slip then
 # drops the force to mu Fn and leaves it there: a cap, as history's; docs/law.md).
-HISTORY_MUS = (0.5, 0.45, 0.4, 0.3, 0.2, 0.15, 0.1)
+# 0.50-0.40 are the stick-slip runs' mu_s, mu_k and 2 mu_k - mu_s; 0.30, 0.20 and 0.10
+# those of the contrasts (mu_k = 0.35, 0.30) and the range where the angles move.
+HISTORY_MUS = (0.5, 0.45, 0.4, 0.3, 0.2, 0.1)
 PAPER_NU_S = 33.10
 
 
@@ -42,15 +44,16 @@ def matrix(rate, full=True):
         ("ss_0.50_0.45_nus0_exact", dict(ss, nu_s=0.0, slip_timing="exact"), rate, 1, 1),
         ("ss_0.50_0.45_total_step", dict(ss, reset="total", slip_timing="step"), rate, 1, 1),
         ("ss_0.50_0.35_step", dict(ss, mu_k=0.35, slip_timing="step"), rate, 1, 1),
-        ("ss_0.50_0.35_exact", dict(ss, mu_k=0.35, slip_timing="exact"), rate, 1, 1),
-        # Fmin = 0.1 Fn against mu_k = 0.3: where history's angles differ most between the two
+        # Fmin = 0.1 Fn against a saw-tooth mean of 0.3 Fn: history's angles differ most
+        # between those two, so this pair tells which of them a pile follows, and what
+        # nu_s = 0 (no dashpot to hold a sliding contact at Fmin) changes
         ("ss_0.50_0.30_step", dict(ss, mu_k=0.30, slip_timing="step"), rate, 1, 1),
+        ("ss_0.50_0.30_nus0_exact", dict(ss, mu_k=0.30, nu_s=0.0, slip_timing="exact"), rate, 1, 1),
     ]
-    if full:  # the checks of the setting: the rate halved, the step halved
+    if full:  # the checks of the setting, each at the cost of one run: the rate halved, the step halved
         runs += [
-            ("history_mu0.50_half_rate", {"mu_s": 0.5, "mu_k": 0.5, "nu_s": 0.0}, rate / 2, 1.5, 1),
-            ("ss_0.50_0.35_step_half_rate", dict(ss, mu_k=0.35, slip_timing="step"), rate / 2, 1.5, 1),
-            ("ss_0.50_0.35_step_half_dt", dict(ss, mu_k=0.35, slip_timing="step"), rate, 1, 0.5),
+            ("history_mu0.50_half_rate", {"mu_s": 0.5, "mu_k": 0.5, "nu_s": 0.0}, rate / 2, 1, 1),
+            ("ss_0.50_0.30_step_half_dt", dict(ss, mu_k=0.30, slip_timing="step"), rate, 0.5, 0.5),
         ]
     return runs
 
@@ -127,25 +130,56 @@ def plan(scene_path, out_runs, rate, duration, fill, seed, labels, full):
     return jobs
 
 
-def _done(folder, data):
-    """A run is finished when its summary and slope series are on disk for the same settings
-    (the scene's data but its description: a reworded comment does not call for a rerun)."""
-    def physics(d):
-        return {k: v for k, v in d.items() if k != "description"}
+def _done(folder, record):
+    """A run is finished when its summary and slope series are on disk for the same engine
+    and scene (the scene's data but its description: a reworded comment does not call for
+    a rerun)."""
+    def physics(r):
+        return {**r, "scene": {k: v for k, v in r["scene"].items() if k != "description"}}
     try:
-        return (physics(json.loads((folder / "settings.json").read_text())) == physics(data)
+        return (physics(json.loads((folder / "settings.json").read_text())) == physics(record)
                 and (folder / "summary.json").is_file() and (folder / "slope.csv").is_file())
-    except (OSError, ValueError):
+    except (OSError, ValueError, KeyError, TypeError):
         return False
+
+
+def _record(data, engine):
+    return {"engine": engine, "scene": _jsonable(data)}
+
+
+def run_one(sc, data, folder, engine="liggghts", ranks=1, keep_timeseries=False, progress=True):
+    """Run one drum scene unless it is on disk already; keep its slope series (slope.csv:
+    t, both angles, kinetic energy, contacts, slip statistics), summary and settings. The
+    run is written to <folder>.part and renamed when whole, so an interruption at any
+    point loses no finished run and leaves no half one that looks finished."""
+    record = _record(data, engine)
+    if _done(folder, record):
+        return False
+    tmp = folder.with_name(folder.name + ".part")
+    if tmp.exists():
+        shutil.rmtree(tmp)
+    _, df = runner.run_scene(sc, engine, tmp, progress=progress, ranks=ranks, write_timeseries=keep_timeseries)
+    keep = ["t", "ekin", "n_contacts"] + [c for c in df.columns if c in _SLIP_COLUMNS]
+    slope = df[keep].copy()
+    slope.insert(1, "theta_deg", drum.slope_angles(sc, df))
+    slope.insert(2, "theta_centroid_deg", drum.centroid_angles(sc, df))
+    slope.to_csv(tmp / "slope.csv", index=False)
+    (tmp / "settings.json").write_text(json.dumps(record, indent=1))
+    if not keep_timeseries:  # the engine's own files: every grain and contact every row, gigabytes
+        shutil.rmtree(tmp / engine, ignore_errors=True)
+    if folder.exists():
+        shutil.rmtree(folder)
+    os.replace(tmp, folder)
+    return True
 
 
 def run_study(scene_path, out, out_runs, rate, duration, fill=None, seed=None, labels=None, full=True, ranks=2,
               keep_timeseries=False, progress=True, tables_only=False):
     jobs = plan(scene_path, out_runs, rate, duration, fill, seed, labels, full)
-    todo = [j for j in jobs if not _done(j[3], _jsonable(j[2]))]
+    todo = [j for j in jobs if not _done(j[3], _record(j[2], "liggghts"))]
     if tables_only:  # the tables and figures of the runs finished so far
         return write_results([j for j in jobs if j not in todo], Path(out))
-    cost = {j[0]: j[1].steps * len(j[1].grains) / SPEED.get(ranks, SPEED[1] * ranks) for j in todo}
+    cost = {j[0]: estimate(j[1], ranks) for j in todo}
     say = sys.stderr.write
     say(f"stickslip drum-study: {len(jobs)} runs, {len(jobs) - len(todo)} already on disk in {out_runs}; "
         f"{len(todo)} to run on LIGGGHTS ({ranks} MPI ranks), about {sum(cost.values()) / 60:.0f} min\n")
@@ -154,24 +188,13 @@ def run_study(scene_path, out, out_runs, rate, duration, fill=None, seed=None, l
         left = sum(cost[j[0]] for j in todo[k:])
         say(f"[{k + 1}/{len(todo)}] {label}: {sc.steps:,} steps x {len(sc.grains)} grains, ~{cost[label]:.0f} s "
             f"(study: ~{left / 60:.0f} min left, {(time.perf_counter() - t_start) / 60:.1f} min so far)\n")
-        tmp = folder.with_name(folder.name + ".part")
-        if tmp.exists():
-            shutil.rmtree(tmp)
-        summary, df = runner.run_scene(sc, "liggghts", tmp, progress=progress, ranks=ranks)
-        theta = drum.slope_angles(sc, df)
-        keep = ["t", "ekin", "n_contacts"] + [c for c in df.columns if c in _SLIP_COLUMNS]
-        slope = df[keep].copy()
-        slope.insert(1, "theta_deg", theta)
-        slope.insert(2, "theta_centroid_deg", drum.centroid_angles(sc, df))
-        slope.to_csv(tmp / "slope.csv", index=False)
-        (tmp / "settings.json").write_text(json.dumps(_jsonable(data), indent=1))
-        if not keep_timeseries:  # every grain every row: ~100 MB a run
-            (tmp / "timeseries.csv").unlink()
-            shutil.rmtree(tmp / "liggghts", ignore_errors=True)
-        if folder.exists():
-            shutil.rmtree(folder)
-        os.replace(tmp, folder)  # a run is on disk whole, or not at all
+        run_one(sc, data, folder, "liggghts", ranks, keep_timeseries, progress)
     return write_results(jobs, Path(out))
+
+
+def estimate(sc, ranks):
+    """Seconds a run takes on LIGGGHTS with `ranks` processes (SPEED), only to say beforehand."""
+    return sc.steps * len(sc.grains) / SPEED.get(ranks, SPEED[1] * ranks)
 
 
 _SLIP_COLUMNS = ("n_slipping", "n_slip_above_vd", "n_slip_above_vstar", "slip_fs_fn_sum")
@@ -213,7 +236,6 @@ def write_results(jobs, out):
     study = pd.DataFrame(rows, columns=STUDY_COLUMNS)
     study.to_csv(out / "study.csv", index=False)
     pd.DataFrame(events).to_csv(out / "avalanches.csv", index=False)
-    from . import drum_figures
     figs = drum_figures.draw(out, study, pd.DataFrame(events), {j[0]: j[3] for j in jobs})
     (out / "study.md").write_text(_table(study, figs))
     print(f"wrote {out / 'study.csv'}, {out / 'avalanches.csv'}, {out / 'study.md'} and {len(figs)} figures")
@@ -239,6 +261,16 @@ def _table(study, figs):
                      f"{r.rate_rad_s:g} | {r.dt_s:g} | {int(r.avalanches)} ({int(r.slides)}) | {angles} | "
                      f"{r.avalanche_share_above_vd:.2f} | {r.avalanche_share_above_vstar:.2f} | "
                      f"{r.avalanche_slip_fs_fn:.3f} |")
+    lines += ["", "## Which history μ gives the same angle", "",
+              "For each stick-slip run, the friction coefficients μ of stock history whose mean angle agrees with "
+              "the run's within two combined standard errors (history interpolated linearly between its runs; "
+              "'none': no history run agrees; drum_figures.consistent_mu).", "",
+              "| run | μs | μk | 2μk−μs | θ_start | θ_stop | θc_start | θc_stop |", "|---|---|---|---|---|---|---|---|"]
+    ranges = {k: drum_figures.consistent_mu(study, k) for k in ("theta_start", "theta_stop", "theta_start_centroid",
+                                                                 "theta_stop_centroid")}
+    for _, r in drum_figures.stick_slip(study).iterrows():
+        cells = [", ".join(f"{a:.2f}–{b:.2f}" for a, b in ranges[k][r.label]) or "none" for k in ranges]
+        lines.append(f"| {r.label} | {r.mu_s:g} | {r.mu_k:g} | {2 * r.mu_k - r.mu_s:.2f} | " + " | ".join(cells) + " |")
     lines += [""] + [f"![{f}]({f})" for f in figs] + [""]
     return "\n".join(lines)
 
@@ -267,28 +299,3 @@ def report_section(report_dir, docs=DOCS):
     for png in sorted(docs.glob("drum_*.png")):
         lines += [f"![{png.stem}]({rel}/{png.name})", ""]
     return "\n".join(lines)
-
-
-def engine_costs(out, engines, duration=0.3, progress=False):
-    """Each engine's cost on the drum: the first `duration` s of cases/drum.toml (the fill
-    falls and packs: ~350 contacts), run side by side in one call; grain-steps per second
-    of the engine's own loop (RunResult.wall_time_s) and, for LIGGGHTS, on 1 and 2 ranks.
-    Written to costs.csv."""
-    from .scene import load
-
-    sc = load("drum", duration=duration, every=1000)
-    rows = []
-    for engine, ranks in [(e, 1) for e in engines] + ([("liggghts", 2)] if "liggghts" in engines else []):
-        summary, _ = runner.run_scene(sc, engine, Path(out) / "costs" / f"{engine}_{ranks}", progress=progress,
-                                      ranks=ranks)
-        rows.append({"engine": engine, "ranks": ranks, "steps": summary["steps"], "grains": len(sc.grains),
-                     "wall_time_s": summary["wall_time_s"],
-                     "grain_steps_per_s": summary["steps"] * len(sc.grains) / summary["wall_time_s"]})
-    table = pd.DataFrame(rows)
-    one = table[(table.engine == "liggghts") & (table.ranks == 1)]
-    two = table[(table.engine == "liggghts") & (table.ranks == 2)]
-    if len(one) and len(two):
-        table.loc[two.index, "speedup_vs_1_rank"] = float(one.wall_time_s.iloc[0] / two.wall_time_s.iloc[0])
-    Path(out).mkdir(parents=True, exist_ok=True)
-    table.to_csv(Path(out) / "costs.csv", index=False)
-    return table

@@ -45,9 +45,11 @@ def prepare_output(out_dir) -> Path:
     return out
 
 
-def run_scene(scene, engine, out_dir, progress=True, ranks=1):
+def run_scene(scene, engine, out_dir, progress=True, ranks=1, write_timeseries=True):
     """Run a validated scene on an engine; write timeseries.csv and summary.json into
-    out_dir; returns (summary, timeseries). ranks > 1: MPI processes (LIGGGHTS only)."""
+    out_dir; returns (summary, timeseries). ranks > 1: MPI processes (LIGGGHTS only).
+    write_timeseries=False: for a study that keeps only a reduction of the series (a long
+    drum run's CSV is gigabytes and takes longer to write than to reduce)."""
     adapter = adapters.get(engine)
     if ranks > 1 and engine != "liggghts":
         raise SceneError(f"--ranks {ranks}: only LIGGGHTS runs on several MPI processes (engine {engine}: 1)")
@@ -73,7 +75,8 @@ def run_scene(scene, engine, out_dir, progress=True, ranks=1):
     if bad:
         row = int(np.flatnonzero(~np.isfinite(df[bad[0]].to_numpy(float)))[0])
         raise EngineError(f"{engine}: non-finite {bad[0]} at t = {df['t'].iloc[row]:g} s (the run diverged)")
-    _write(out_dir / "timeseries.csv", lambda p: df.to_csv(p, index=False))
+    if write_timeseries:
+        _write(out_dir / "timeseries.csv", lambda p: df.to_csv(p, index=False))
     summary = {
         "scene": scene.name, "engine": engine, "law": scene.contact.law, "reset": scene.contact.reset,
         "slip_timing": scene.contact.slip_timing, "dt_s": scene.dt, "steps": int(result.steps),

@@ -190,14 +190,14 @@ def test_avalanches_are_found_in_the_kinetic_energy():
 
 @needs_liggghts
 def test_drum_on_liggghts_is_pyrefs_step_for_step(tmp_path):
-    """The drum's first 0.05 s (5000 steps: the fill falls, hits the ring and itself,
+    """The drum's first 0.05 s (3125 steps: the fill falls, hits the ring and itself,
     ~300 contacts, rolling, slips, turning gravity) on LIGGGHTS and pyref. Both solve the
     same equations, so they differ by round-off, amplified by the collisions (the pile is
     chaotic: the difference grows ~e-fold every 4 ms, 1e-20 m at the first contacts to
     ~1e-12 m at 0.05 s, and ~1 mm by 0.2 s, where the trajectories part). Any difference
     in the physics shows far above 1e-10 m: lever arms of r instead of r - delta/2 gave
     1.6e-8 m 0.01 s after the first contacts. The slip statistics are counts: equal."""
-    sc = scene_mod.load("drum", duration=0.05, every=250)
+    sc = scene_mod.load("drum", duration=0.05, every=125)
     dl = liggghts_adapter.run(sc, tmp_path).timeseries
     dp = columns.frame(sc, Simulation(sc).run())
     assert list(dl.columns) == list(dp.columns)
@@ -213,7 +213,7 @@ def test_drum_on_liggghts_is_pyrefs_step_for_step(tmp_path):
 def test_drum_on_two_mpi_ranks_is_one_ranks(tmp_path):
     """The same 0.05 s on 1 and 2 MPI ranks: the ranks split the drum, so sums run in
     another order; the same round-off bound as against pyref."""
-    sc = scene_mod.load("drum", duration=0.05, every=250)
+    sc = scene_mod.load("drum", duration=0.05, every=125)
     d1 = liggghts_adapter.run(sc, tmp_path / "one").timeseries
     d2 = liggghts_adapter.run(sc, tmp_path / "two", np_ranks=2).timeseries
     pos = [c for c in d1.columns if c.endswith(("_x", "_y"))]
@@ -302,3 +302,63 @@ def test_drum_on_yade_parts_from_pyref_by_its_leapfrog_start_only(tmp_path):
     assert np.linalg.norm(offset) > 1e-7  # the offset is there, far above round-off
     ring = [g.name for g in sc.grains if g.fixed]
     assert not any(f"{g}_x" in dy for g in ring)  # (the ring is not recorded; fixed: tested on pyref)
+
+
+# ---------------------------------------------------------------- across engines, and the map
+
+def test_efolding_time_of_a_made_up_divergence():
+    """A distance growing as 1e-20 m e^(t/3 ms) from round-off until it saturates at 1 mm
+    (grains gone different ways): the fit over FIT_RANGE gives back the 3 ms."""
+    from stickslip.drum_engines import FIT_RANGE, efolding_time
+
+    t = np.arange(0, 0.4, 4e-4)
+    d = np.minimum(1e-20 * np.exp(t / 3e-3), 1e-3)
+    tau, t0, t1 = efolding_time(t, d)
+    assert tau == pytest.approx(3e-3, rel=1e-9)
+    assert 1e-20 * math.exp(t0 / 3e-3) > FIT_RANGE[0] and 1e-20 * math.exp(t1 / 3e-3) < FIT_RANGE[1]
+    assert math.isnan(efolding_time(t, np.full(len(t), 1e-16))[0])  # nothing grows: no time to give
+
+
+def test_consistent_mu_inverts_a_made_up_history_curve():
+    """History angles rising as 10 + 40 mu deg (standard error 0.5); a stick-slip run at
+    22 +- 0.5 deg agrees within two combined errors with mu in 0.3 -+ 2 sqrt(0.5^2 + 0.5^2) / 40;
+    one at 5 deg with none."""
+    from stickslip import drum_figures
+
+    mus = [0.1, 0.2, 0.3, 0.4, 0.5]
+    rows = [{"label": f"history_mu{m:.2f}", "mu_s": m, "mu_k": m, "theta_stop_mean_deg": 10 + 40 * m,
+             "theta_stop_se_deg": 0.5} for m in mus]
+    rows += [{"label": "ss_a", "mu_s": 0.5, "mu_k": 0.4, "theta_stop_mean_deg": 22.0, "theta_stop_se_deg": 0.5},
+             {"label": "ss_b", "mu_s": 0.5, "mu_k": 0.4, "theta_stop_mean_deg": 5.0, "theta_stop_se_deg": 0.5}]
+    got = drum_figures.consistent_mu(pd.DataFrame(rows), "theta_stop")
+    half = 2 * math.hypot(0.5, 0.5) / 40
+    [(lo, hi)] = got["ss_a"]
+    assert lo == pytest.approx(0.3 - half, abs=4e-4) and hi == pytest.approx(0.3 + half, abs=4e-4)
+    assert got["ss_b"] == []
+
+
+def test_a_dump_cut_short_is_one_line(tmp_path):
+    """A LIGGGHTS dump whose last block lost rows (a run killed while writing) is refused."""
+    block = "ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n0 1\nITEM: ATOMS id x \n"
+    (tmp_path / "a.dump").write_text(block.format(0) + "1 0.5 \n2 0.25 \n" + block.format(10) + "1 0.5 \n")
+    with pytest.raises(RuntimeError, match="cut short at step 10"):
+        liggghts_adapter._read_dump(tmp_path / "a.dump")
+    (tmp_path / "b.dump").write_text(block.format(0) + "1 0.5 \n2 0.25 \n")
+    assert liggghts_adapter._read_dump(tmp_path / "b.dump")[0].tolist() == [[1.0, 0.5], [2.0, 0.25]]
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--duration", "5"], ["--duration 5", "> 9"]),
+    (["--parts", "everything"], ["--parts", "invalid choice"]),
+])
+def test_drum_engines_refuses_bad_settings_in_one_line(args, words, tmp_path, capsys):
+    try:
+        code = main(["drum-engines", "--runs", str(tmp_path / "runs"), "--out", str(tmp_path / "out"),
+                     "--engines", "pyref", *args])
+    except SystemExit as e:
+        code = e.code
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "\n" not in err
+    for w in words:
+        assert w in err, (w, err)
+    assert not (tmp_path / "runs").exists()
