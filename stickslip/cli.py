@@ -100,12 +100,14 @@ def build_parser():
     ds.add_argument("--runs", type=_folder, default=Path("runs/drum_study"),
                     help="the runs, kept for resuming (default: runs/drum_study)")
     ds.add_argument("--rate", type=_positive, help="drum rate, rad/s (default: the scene's)")
-    ds.add_argument("--duration", type=_positive, default=75.0, help="simulated time per run, s (default: 75)")
+    ds.add_argument("--duration", type=_positive, default=180.0, help="simulated time per run, s (default: 180)")
     ds.add_argument("--fill", type=_positive, help="share of the drum filled (default: the scene's grain count)")
     ds.add_argument("--seed", type=int, help="the fill's random seed (default: the scene's)")
     ds.add_argument("--only", nargs="+", help="run only these runs of the matrix (labels)")
     ds.add_argument("--no-checks", action="store_true", help="leave out the half-rate and half-dt runs")
-    ds.add_argument("--ranks", type=_count, default=os.cpu_count() or 1, help="MPI ranks (default: every core)")
+    ds.add_argument("--ranks", type=_count, default=os.cpu_count() or 1,
+                    help="MPI ranks of each run (default: every core)")
+    ds.add_argument("--jobs", type=_count, default=1, help="runs side by side (default: 1)")
     ds.add_argument("--tables-only", action="store_true",
                     help="write the tables and figures of the runs finished so far; run nothing")
     ds.add_argument("--keep-timeseries", action="store_true",
@@ -234,7 +236,7 @@ def cmd_drum_study(args):
     if rate is None:
         raise SceneError(f"--scene {args.scene}: not a turning drum (no gravity_rate); give --rate")
     run_study(path, args.out, args.runs, rate, args.duration, fill=args.fill, seed=args.seed, labels=args.only,
-              full=not args.no_checks, ranks=args.ranks, keep_timeseries=args.keep_timeseries,
+              full=not args.no_checks, ranks=args.ranks, jobs_at_once=args.jobs, keep_timeseries=args.keep_timeseries,
               progress=not args.quiet, tables_only=args.tables_only)
     return 0
 

@@ -174,15 +174,29 @@ def run_one(sc, data, folder, engine="liggghts", ranks=1, keep_timeseries=False,
 
 
 def run_study(scene_path, out, out_runs, rate, duration, fill=None, seed=None, labels=None, full=True, ranks=2,
-              keep_timeseries=False, progress=True, tables_only=False):
+              jobs_at_once=1, keep_timeseries=False, progress=True, tables_only=False):
+    """The matrix on LIGGGHTS: `jobs_at_once` runs side by side, each on `ranks` MPI
+    processes; the cost said first, a line per run started and finished, the table and
+    figures at the end."""
     jobs = plan(scene_path, out_runs, rate, duration, fill, seed, labels, full)
     todo = [j for j in jobs if not _done(j[3], _record(j[2], "liggghts"))]
     if tables_only:  # the tables and figures of the runs finished so far
         return write_results([j for j in jobs if j not in todo], Path(out))
-    cost = {j[0]: estimate(j[1], ranks) for j in todo}
+    cost = {j[0]: estimate(j[1], ranks) / min(jobs_at_once, max(1, len(todo))) for j in todo}
     say = sys.stderr.write
     say(f"stickslip drum-study: {len(jobs)} runs, {len(jobs) - len(todo)} already on disk in {out_runs}; "
-        f"{len(todo)} to run on LIGGGHTS ({ranks} MPI ranks), about {sum(cost.values()) / 60:.0f} min\n")
+        f"{len(todo)} to run on LIGGGHTS ({jobs_at_once} at once, {ranks} MPI rank{'s' if ranks > 1 else ''} each), "
+        f"about {sum(cost.values()) / 60:.0f} min\n")
+    if jobs_at_once > 1:  # independent runs side by side: stickslip/parallel.py, longest first
+        from . import parallel
+
+        tasks = [(cost[label], run_one, (sc, data, folder, "liggghts", ranks, keep_timeseries, False))
+                 for label, sc, data, folder in todo]
+        done = parallel.run_all(tasks, "drum-study", progress, n_workers=jobs_at_once)
+        failed = [r for r in done if isinstance(r, Exception)]
+        if failed:
+            raise failed[0]
+        return write_results(jobs, Path(out))
     t_start = time.perf_counter()
     for k, (label, sc, data, folder) in enumerate(todo):
         left = sum(cost[j[0]] for j in todo[k:])

@@ -29,17 +29,19 @@ def _call(fn, args):
         return e
 
 
-def run_all(tasks, label="runs", progress=True):
+def run_all(tasks, label="runs", progress=True, n_workers=None):
+    """n_workers: processes (default: workers())."""
+    n_workers = n_workers or workers()
     order = sorted(range(len(tasks)), key=lambda k: -tasks[k][0])
     results = [None] * len(tasks)
     bar = _Bar(label, len(tasks), progress)
-    if workers() == 1 or len(tasks) == 1:
+    if n_workers == 1 or len(tasks) == 1:
         for k in order:
             results[k] = _call(*tasks[k][1:])
             bar.done()
         bar.close()
         return results
-    with ProcessPoolExecutor(max_workers=workers()) as pool:
+    with ProcessPoolExecutor(max_workers=n_workers) as pool:
         pending = {pool.submit(_call, *tasks[k][1:]): k for k in order}
         while pending:
             finished, _ = wait(pending, timeout=1.0, return_when=FIRST_COMPLETED)
