@@ -188,6 +188,7 @@ class StickSlipLaw:
         # "Energy"; >= 0 in the step mode when nu_s/Ks <= dt).
         self.min_dissipation = 0.0
         self.error = None  # the message of the error that stopped the run, if any
+        self.setup_step = False  # True: the next step loads no spring (velocity_verlet_start)
         self.full_reads = 0  # steps that read the whole interaction set (diagnostics, bench)
         self.set_checks = 0  # steps whose contact set check=True compared with YADE's
         self.nbodies = -1
@@ -378,7 +379,10 @@ class StickSlipLaw:
                 a == b for a, b in zip(engines, self._engines)):
             self._validate(O, engines)
         self.last_iter = it
-        dt = O.dt
+        # A setup step (velocity_verlet_start) evaluates the forces at the current state with
+        # no time elapsed for the springs, as pyref's and LIGGGHTS' setup does.
+        dt = 0.0 if self.setup_step else O.dt
+        self.setup_step = False
         P, V, W, A = self._kinematics()
         if not math.isfinite(A.sum()):  # (one reduction; the culprit is looked for only if needed)
             self._finite_bodies(it, P, V, W)
@@ -445,6 +449,12 @@ class StickSlipLaw:
         energy = O.trackEnergy
         tan = tangential_force(rotate_history(self.D, n), V_s, fn, dt, self.params, energy=energy)
         F_s = tan.force
+        apart = delta <= 0
+        if apart.any():  # YADE's real interactions include spheres touching a wall or facet at zero
+            # overlap; for the law that is no contact yet (docs/law.md step 3): no force, no spring
+            F_s[apart], tan.spring[apart], tan.slipped[apart] = 0.0, 0.0, False
+            if energy:
+                tan.dissipated_dashpot[apart] = tan.dissipated_slip[apart] = 0.0
         if not math.isfinite(fn.sum() + F_s.sum()):  # (a sum is finite only if all its terms are)
             k = int(np.flatnonzero(~(np.isfinite(fn) & np.isfinite(F_s).all(axis=1)))[0])
             self._fail(f"non-finite force on contact ({i1[k]}, {i2[k]}) at iteration {it} (Fn = {fn[k]!r}, "
@@ -655,20 +665,24 @@ class StickSlipLaw:
             if g is None:
                 broken[j] = True
                 wr.pop(k, None)
-                rows.append((0.0,) * 8)
+                rows.append((0.0,) * 5)
             else:
-                rows.append(g.normal.__getinitargs__() + g.contactPoint.__getinitargs__()
-                            + (g.penetrationDepth, I.phys.normalForce.norm()))
-        A = np.array(rows).reshape(m, 8)
-        n, c = A[:, 0:3], A[:, 3:6]
+                rows.append(g.normal.__getinitargs__() + (g.penetrationDepth, I.phys.normalForce.norm()))
+        A = np.array(rows).reshape(m, 5)
+        n, delta = A[:, 0:3], A[:, 3]
         i1, i2, r1, r2 = idx[0][other], idx[1][other], idx[4][other], idx[5][other]
         x2 = P[i2]
         if shift is not None:
             x2 = x2 + (self.cell[other] if cell is None else cell[other]) @ shift[0].T
-        half = 0.5 * A[:, 6]  # a sphere's lever arm reaches midway into the overlap (docs/law.md)
-        return {"broken": broken, "n": n, "delta": A[:, 6], "fn": A[:, 7],
-                "a1": self._arm(self.sphere[i1], r1 - half, n, c - P[i1]),
-                "a2": self._arm(self.sphere[i2], -(r2 - half), n, c - x2)}
+        # The wall's (facet's, box's) side of the contact is the point of its surface nearest
+        # the sphere's centre, x - (r - delta) n: the wall moves there (docs/law.md step 1, as
+        # pyref and LIGGGHTS; YADE's contactPoint is midway in the overlap for facets and boxes).
+        s1 = self.sphere[i1]
+        surface = np.where(s1[:, None], P[i1] + (r1 - delta)[:, None] * n, x2 - (r2 - delta)[:, None] * n)
+        half = 0.5 * delta  # a sphere's lever arm reaches midway into the overlap (docs/law.md)
+        return {"broken": broken, "n": n, "delta": delta, "fn": A[:, 4],
+                "a1": self._arm(s1, r1 - half, n, surface - P[i1]),
+                "a2": self._arm(self.sphere[i2], -(r2 - half), n, surface - x2)}
 
     @staticmethod
     def _arm(sphere, r, n, to_point):
@@ -994,3 +1008,43 @@ def _extra_engines(extra):
         if isinstance(e, (Collider, ForceResetter, InteractionLoop, NewtonIntegrator)):
             raise ValueError(f"extra[{k}] = {type(e).__name__}: stickslip_engines already has one")
     return extra
+
+
+def velocity_verlet_start(law=None):
+    """Make YADE's first step the start of velocity Verlet (pyref, LIGGGHTS), for a run that
+    must be their twin; call it once, instead of the first O.step().
+
+    YADE's leapfrog takes a body's velocity as v(t - dt/2): its first step computes the
+    forces from v(0), loads every spring by V_s dt and gives the whole kick
+    v(dt/2) = v(0) + dt F(0)/m. Velocity Verlet evaluates the forces at the start with no
+    time elapsed (the springs not loaded) and gives half a kick. This step does the same:
+    the law's forces at x(0), v(0) as a setup evaluation (law.setup_step), then each
+    dynamic sphere gets v(dt/2) = v(0) + dt/2 F(0)/m (the mean of YADE's v(0) and
+    v(0) + dt F(0)/m), x(dt) = x(0) + dt v(dt/2), and its spin likewise. From then on
+    leapfrog and velocity Verlet give the same positions and forces."""
+    import builtins
+
+    from yade import O, Quaternion, Sphere, Vector3
+
+    law = builtins.stickslip_law if law is None else law
+    if O.iter != 0:
+        raise RuntimeError(f"velocity_verlet_start: the scene is at iteration {O.iter}; it starts a run (iteration 0)")
+    bodies = [b for b in O.bodies if b is not None and b.dynamic]
+    for b in bodies:
+        if not isinstance(b.shape, Sphere) or b.isClump or b.isClumpMember:
+            raise ValueError(f"velocity_verlet_start: body {b.id} is not a free sphere (clumps and other shapes "
+                             f"are not supported)")
+    # (copies: a State's vectors are views of YADE's own)
+    start = [(Vector3(b.state.pos), Vector3(b.state.vel), Vector3(b.state.angVel), Quaternion(b.state.ori))
+             for b in bodies]
+    law.setup_step = True
+    O.step()
+    dt = O.dt
+    for b, (x0, v0, w0, q0) in zip(bodies, start):
+        s = b.state
+        v = v0 + 0.5 * (s.vel - v0)
+        s.vel, s.pos = v, x0 + dt * v
+        w = w0 + 0.5 * (s.angVel - w0)
+        if w != s.angVel:
+            s.angVel = w
+            s.ori = (Quaternion(w / w.norm(), w.norm() * dt) * q0) if w.norm() > 0 else q0
