@@ -243,8 +243,7 @@ def main(scene_path, out_path):
             before, kin = grains_now(), kin_before(step)
         O.step()
         for k, (key, _) in enumerate(pairs):
-            got = law.lookup(*key)
-            if got is not None and got[2]:
+            if law.has_slipped(*key):
                 slips[k] += 1
         if step % every == 0:
             rows.append(row(step, before, kin))

@@ -37,11 +37,11 @@ from .checks import check_parameters
 from .engines import insert_stickslip, stickslip_engines, stickslip_material
 from .kernel import rotate_history, tangential_force
 from .law import StickSlipLaw
-from .runner import step, stickslip_runner
+from .runner import resume, step, stickslip_runner
 from .verlet_start import velocity_verlet_start
 
 __all__ = ["stickslip_material", "stickslip_engines", "stickslip_runner", "insert_stickslip", "velocity_verlet_start",
-           "check_parameters", "StickSlipLaw", "step", "rotate_history", "tangential_force"]
+           "check_parameters", "StickSlipLaw", "step", "resume", "rotate_history", "tangential_force"]
 
 try:  # YADE's savers store the law's state first (checkpoints.py); outside YADE there is nothing to hook
     from .checkpoints import install_save_hooks

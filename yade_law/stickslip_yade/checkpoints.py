@@ -9,6 +9,8 @@ refuses to continue otherwise (a silent restart of every spring would be a wrong
 """
 import base64
 import json
+import os
+import re
 
 import numpy as np
 
@@ -17,6 +19,27 @@ from .checks import fail
 LAWS = {}  # token -> StickSlipLaw, the laws of this process (the token names a law in its runner's command)
 TAG = "stickslip_law"  # the key in O.tags
 SCALARS = ("last_iter", "min_dissipation", "max_fn_error", "checked")  # the law's own, saved too
+HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # yade_law/, where stickslip_yade is found
+
+
+# The runner's command comes in two forms. PyRunner compiles its command at every step, which
+# costs about 1 us per 10 characters: while the law runs in this process its runner carries
+# the short form (a name this package puts in builtins); a saved scene carries the robust
+# form, which imports stickslip_yade from its own folder if the process has not (a scene
+# loaded by O.load in a new process) and, once run, gives its runner the short form again.
+def short_command(token):
+    return f"_stickslip_step({token!r})"
+
+
+def robust_command(token):
+    return (f"(__import__('sys').modules.get('stickslip_yade') or (__import__('sys').path.append({HERE!r}), "
+            f"__import__('stickslip_yade'))[1]).resume({token!r})")
+
+
+def token_of(command):
+    """The token of the law a runner's command runs (any form, older ones included), or None."""
+    m = re.search(r"(?:_stickslip_step|stickslip_yade'\)\)\[1\]\)\.(?:step|resume))\('([0-9a-f]{16})'\)$", command)
+    return m.group(1) if m else None
 
 
 def saved_state(law, O, fresh=False):
@@ -63,16 +86,24 @@ def adopt(law, O, scene):
 
 def store_state():
     """Before YADE serialises the scene: put the state of the law that runs in it into
-    O.tags, with the iteration, so that any load can check it belongs to the scene."""
+    O.tags, with the iteration, so that any load can check it belongs to the scene, and give
+    its runner the robust command. Returns [(runner, command)] to put back after saving."""
     from yade import O, PyRunner
 
+    put_back = []
     for e in O.engines:
-        if isinstance(e, PyRunner) and "stickslip_yade" in e.command and ".step('" in e.command:
-            law = LAWS.get(e.command.rsplit(".step('", 1)[1].split("'")[0])
-            if law is None:  # a loaded scene whose law has not run here: its saved state still holds
-                continue
-            fresh = law.scene is None or not O._sceneObj == law.scene
-            O.tags[TAG] = saved_state(law, O, fresh=fresh)
+        token = token_of(e.command) if isinstance(e, PyRunner) else None
+        if token is None:
+            continue
+        if e.command == short_command(token):
+            put_back.append((e, e.command))
+            e.command = robust_command(token)
+        law = LAWS.get(token)
+        if law is None:  # a loaded scene whose law has not run here: its saved state still holds
+            continue
+        fresh = law.scene is None or not O._sceneObj == law.scene
+        O.tags[TAG] = saved_state(law, O, fresh=fresh)
+    return put_back
 
 
 def install_save_hooks():
@@ -86,8 +117,12 @@ def install_save_hooks():
         original = getattr(Omega, name)
 
         def hooked(self, *args, _original=original, **kw):
-            store_state()
-            return _original(self, *args, **kw)
+            put_back = store_state()
+            try:
+                return _original(self, *args, **kw)
+            finally:
+                for runner, command in put_back:
+                    runner.command = command
 
         hooked.__doc__ = original.__doc__
         setattr(Omega, name, hooked)

@@ -92,7 +92,7 @@ def validate_scene(engines, token, bodies):
         return [k for k, e in enumerate(engines) if isinstance(e, kind)]
 
     loops, newton = where(InteractionLoop), where(NewtonIntegrator)
-    mine = [k for k in where(PyRunner) if f".step('{token}')" in engines[k].command]
+    mine = [k for k in where(PyRunner) if f"('{token}')" in engines[k].command]
     if len(loops) != 1 or len(newton) != 1:
         fail(f"O.engines has {len(loops)} InteractionLoop and {len(newton)} NewtonIntegrator: the law works "
              f"with one of each (see stickslip_engines or yade_law/README.md, 'Your own engine list')")

@@ -30,9 +30,6 @@ class ContactSet:
     # and cn (read from YADE once), the last normal and tangential forces, slipped in the
     # last step, slip steps since the contact was made.
     ARRAYS = ("keys", "made", "cell", "D", "kn", "cn", "fn", "F_s", "slipped", "count")
-    # A sphere pair whose recomputed overlap is within this share of r1 + r2 of zero may be
-    # on either side of YADE's own test (round-off of the distance): read the set again.
-    TOUCH_BAND = 1e-12
 
     def __init__(self):
         self.full_reads = 0  # steps that read the whole interaction set (diagnostics, bench)
@@ -51,7 +48,7 @@ class ContactSet:
         """Caches derived from the arrays and from YADE objects (rebuilt on demand)."""
         self.keyset = None  # the keys as a Python set (membership of candidate new contacts)
         self.sorted = None  # {key: row}, for row()
-        self.idx = None  # ids, sphere-pair flags and radii per contact (see index)
+        self.idx = None  # geometry.Layout of the contacts (see index)
         self.wrappers = {}  # key -> YADE Interaction of contacts with a non-sphere
 
     def take(self, rows, keyset_updated=False):
@@ -76,17 +73,12 @@ class ContactSet:
         self.sorted = self.idx = None
 
     def index(self, bodies, keys=None):
-        """(i1, i2, sphere pair?, indices of the other contacts, r1, r2, r1 + r2) of `keys`
-        (default: the law's contacts, cached while they do not change)."""
-        if keys is not None or self.idx is None:
-            k = self.keys if keys is None else keys
-            i1, i2 = k >> 32, k & 0xFFFFFFFF
-            ss = bodies.sphere[i1] & bodies.sphere[i2]
-            r1, r2 = bodies.radius[i1], bodies.radius[i2]
-            idx = (i1, i2, ss, np.flatnonzero(~ss), r1, r2, r1 + r2)
-            if keys is not None:
-                return idx
-            self.idx = idx
+        """The geometry.Layout of `keys` (default: the law's contacts, cached while they do
+        not change)."""
+        if keys is not None:
+            return geometry.Layout(keys, bodies.sphere, bodies.radius)
+        if self.idx is None:
+            self.idx = geometry.Layout(self.keys, bodies.sphere, bodies.radius)
         return self.idx
 
     def row(self, k):
@@ -108,15 +100,14 @@ class ContactSet:
         """Last step's contacts less the broken ones plus this step's new ones, from YADE's
         counts; None when the whole set must be read (see the module docstring)."""
         keys = self.keys
-        idx = self.index(bodies)
-        i1, i2, ss, other, r1, r2, rsum = idx
-        d, dist, delta = geometry.sphere_pairs(P, idx, self.cell, shift)
-        pairs = len(other) < len(keys)
-        if pairs and (np.abs(delta) <= self.TOUCH_BAND * rsum)[ss].any():
+        lay = self.index(bodies)
+        ss, other, pairs = lay.ss, lay.other, lay.pairs
+        d, dist, delta = geometry.sphere_pairs(P, lay, self.cell, shift)
+        if pairs and (np.abs(delta) <= lay.band if lay.all_pairs else (np.abs(delta) <= lay.band)[ss]).any():
             return None
-        g = geometry.with_walls(O, self.wrappers, keys[other], P, idx, other, shift, self.cell, bodies.sphere)
+        g = geometry.with_walls(O, self.wrappers, lay.keys_other, P, lay, shift, self.cell)
         n_alive, broken = len(keys), None
-        if (pairs and delta[ss].min() < 0) or g["broken"].any():
+        if (pairs and (delta if lay.all_pairs else delta[ss]).min() < 0) or g["broken"].any():
             broken = delta < 0  # Law2_ScGeom_ViscElPhys_Basic drops a contact when its overlap < 0
             if len(other):
                 broken &= ss
@@ -132,13 +123,12 @@ class ContactSet:
             remap = np.cumsum(alive) - 1
             kept = ~g["broken"]
             g = {k: v[kept] for k, v in g.items()}
-            other = remap[other[kept]]
             d, dist, delta = d[alive], dist[alive], delta[alive]
             self.take(alive, keyset_updated=True)
-            idx = self.index(bodies)
-        geo = geometry.assemble(idx, d, dist, delta, other, g)
+            lay = self.index(bodies)  # (its other rows: those of g)
+        geo = geometry.assemble(lay, d, dist, delta, g)
         if made:
-            new = self._new_ones(O, bodies, made, idx[0], idx[1])
+            new = self._new_ones(O, bodies, made, lay.i1, lay.i2)
             if new is None:
                 return None
             geo = self._add(O, bodies, P, shift, geo, *new, it)
@@ -189,15 +179,15 @@ class ContactSet:
         is_new = np.ones(m, bool)
         is_new[old] = False
         new = np.flatnonzero(is_new)
-        idx = self.index(bodies)
-        other = idx[3]
+        lay = self.index(bodies)
+        other = lay.other
         for j in other.tolist():
             self.wrappers[int(self.keys[j])] = L[old[j]]
-        d, dist, delta = geometry.sphere_pairs(P, idx, self.cell, shift)
-        g = geometry.with_walls(O, self.wrappers, self.keys[other], P, idx, other, shift, self.cell, bodies.sphere)
+        d, dist, delta = geometry.sphere_pairs(P, lay, self.cell, shift)
+        g = geometry.with_walls(O, self.wrappers, lay.keys_other, P, lay, shift, self.cell)
         if g["broken"].any():
             fail("internal: a real interaction has no geometry")
-        geo = geometry.assemble(idx, d, dist, delta, other, g)
+        geo = geometry.assemble(lay, d, dist, delta, g)
         return self._add(O, bodies, P, shift, geo, keys[new], [L[j] for j in new.tolist()], made[new], None)
 
     def _add(self, O, bodies, P, shift, geo, keys, inters, made, it):
@@ -219,13 +209,13 @@ class ContactSet:
                      "cell": cell, "kn": kn, "cn": cn})
         for k, I in zip(keys.tolist(), inters):
             self.wrappers[k] = I
-        idx = self.index(bodies, keys)
-        i1, i2, ss, other = idx[:4]
-        d, dist, delta = geometry.sphere_pairs(P, idx, cell, shift)
-        g = geometry.with_walls(O, self.wrappers, keys[other], P, idx, other, shift, cell, bodies.sphere)
+        lay = self.index(bodies, keys)
+        i1, i2, ss = lay.i1, lay.i2, lay.ss
+        d, dist, delta = geometry.sphere_pairs(P, lay, cell, shift)
+        g = geometry.with_walls(O, self.wrappers, lay.keys_other, P, lay, shift, cell)
         if g["broken"].any():
             fail("internal: a new real interaction has no geometry")
-        new = geometry.assemble(idx, d, dist, delta, other, g)
+        new = geometry.assemble(lay, d, dist, delta, g)
         if (ss & (dist == 0)).any():
             k = int(np.flatnonzero(ss & (dist == 0))[0])
             fail(f"contact ({i1[k]}, {i2[k]}) at iteration {O.iter}: the two spheres have the same centre, "

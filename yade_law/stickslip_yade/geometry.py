@@ -15,25 +15,61 @@ from .kernel import dot
 from .kinematics import cross, rows
 
 
-def sphere_pairs(P, idx, cell, shift):
+class Layout:
+    """Which contacts are sphere pairs and which meet a wall, facet or box ("other"), with
+    the ids, radii and index arrays a step needs: computed once per set of contacts (keys
+    id1 << 32 | id2; `sphere`, `radius`: per body)."""
+
+    # A sphere pair whose recomputed overlap is within this share of r1 + r2 of zero may be
+    # on either side of YADE's own test (round-off of the distance): read the set again.
+    TOUCH_BAND = 1e-12
+
+    def __init__(self, keys, sphere, radius):
+        i1, i2 = keys >> 32, keys & 0xFFFFFFFF
+        self.i1, self.i2, self.n = i1, i2, len(keys)
+        self.ss = sphere[i1] & sphere[i2]
+        self.other = np.flatnonzero(~self.ss)
+        self.r1, self.r2 = radius[i1], radius[i2]
+        self.rsum = self.r1 + self.r2
+        self.band = self.TOUCH_BAND * self.rsum
+        self.pairs = len(self.other) < self.n  # any sphere pair
+        self.all_pairs = not len(self.other)
+        o = self.other
+        self.keys_other = keys[o]
+        self.o1, self.o2, self.or1, self.or2 = i1[o], i2[o], self.r1[o], self.r2[o]
+        self.s1, self.s2 = sphere[self.o1], sphere[self.o2]  # which side of an "other" contact is the sphere
+        self.s1_any, self.s1_all = bool(self.s1.any()), bool(self.s1.all())
+        self.s2_any, self.s2_all = bool(self.s2.any()), bool(self.s2.all())
+        self._flat = None
+
+    def flat(self):
+        """Indices 3 i + (0, 1, 2) of id1's and id2's force components, for one bincount."""
+        if self._flat is None:
+            k = np.arange(3)
+            self._flat = ((3 * self.i1[:, None] + k).ravel(), (3 * self.i2[:, None] + k).ravel())
+        return self._flat
+
+
+def sphere_pairs(P, lay, cell, shift):
     """Centre-to-centre vector id1 -> id2 (to id2's image across a periodic boundary), its
-    length and the overlap r1 + r2 - distance (meaningful for sphere pairs only); `idx`:
-    ContactSet.index, `cell`: each contact's cellDist, `shift`: kinematics.cell_motion."""
-    i1, i2, ss, other, r1, r2, rsum = idx
-    if not ss.any():
-        z = np.zeros(len(i1))
-        return np.zeros((len(i1), 3)), z, z.copy()
-    d = P[i2] - P[i1]
+    length and the overlap r1 + r2 - distance (meaningful for sphere pairs only); `cell`:
+    each contact's cellDist, `shift`: kinematics.cell_motion."""
+    if not lay.pairs:
+        z = np.zeros(lay.n)
+        return np.zeros((lay.n, 3)), z, z.copy()
+    d = P[lay.i2] - P[lay.i1]
     if shift is not None:
         d += cell @ shift[0].T
     dist = np.sqrt(dot(d, d))
-    return d, dist, rsum - dist
+    return d, dist, lay.rsum - dist
 
 
-def with_walls(O, wrappers, keys, P, idx, other, shift, cell, sphere):
-    """Contacts with a wall, box or facet (rows `other` of idx, cellDist `cell`): YADE's
-    normal, overlap and normal force, read one by one (about 2.5 us each; `wrappers`: key ->
-    YADE Interaction, kept between steps); `broken` where the interaction is no longer real."""
+def with_walls(O, wrappers, keys, P, lay, shift, cell):
+    """Contacts with a wall, box or facet (the "other" rows of `lay`, their keys `keys`,
+    cellDist `cell`): YADE's normal, overlap and normal force, read one by one (about 2.5 us
+    each; `wrappers`: key -> YADE Interaction, kept between steps); `broken` where the
+    interaction is no longer real; the centres x1, x2 of both sides (id2's image across a
+    periodic boundary), from which `arms` finds the lever arms if they are needed."""
     m = len(keys)
     broken = np.zeros(m, bool)
     if not m:
@@ -51,96 +87,111 @@ def with_walls(O, wrappers, keys, P, idx, other, shift, cell, sphere):
         else:
             rows.append(g.normal.__getinitargs__() + (g.penetrationDepth, I.phys.normalForce.norm()))
     A = np.array(rows).reshape(m, 5)
-    n, delta = A[:, 0:3], A[:, 3]
-    i1, i2, r1, r2 = idx[0][other], idx[1][other], idx[4][other], idx[5][other]
-    x2 = P[i2]
+    x2 = P[lay.o2]
     if shift is not None:
-        x2 = x2 + cell[other] @ shift[0].T
-    # The wall's (facet's, box's) side of the contact is the point of its surface nearest
-    # the sphere's centre, x - (r - delta) n: the wall moves there (docs/law.md step 1, as
-    # pyref and LIGGGHTS; YADE's contactPoint is midway in the overlap for facets and boxes).
-    s1 = sphere[i1]
-    surface = np.where(s1[:, None], P[i1] + (r1 - delta)[:, None] * n, x2 - (r2 - delta)[:, None] * n)
-    half = 0.5 * delta  # a sphere's lever arm reaches midway into the overlap (docs/law.md)
-    return {"broken": broken, "n": n, "delta": delta, "fn": A[:, 4],
-            "a1": arm(s1, r1 - half, n, surface - P[i1]),
-            "a2": arm(sphere[i2], -(r2 - half), n, surface - x2)}
+        x2 = x2 + cell[lay.other] @ shift[0].T
+    return {"broken": broken, "n": A[:, 0:3], "delta": A[:, 3], "fn": A[:, 4], "x1": P[lay.o1], "x2": x2}
 
 
-def arm(sphere, r, n, to_point):
+def arms(lay, geo):
+    """The lever arms (a1, a2) of the "other" contacts, one row each, from the centres to the
+    points whose velocities meet; computed when first asked for (only turning walls and
+    spinning spheres need them) and kept in `geo`."""
+    if "a1o" not in geo:
+        n, delta, x1, x2, r1, r2 = geo["no"], geo["do"], geo["x1o"], geo["x2o"], lay.or1, lay.or2
+        # The wall's (facet's, box's) side of the contact is the point of its surface nearest
+        # the sphere's centre, x - (r - delta) n: the wall moves there (docs/law.md step 1, as
+        # pyref and LIGGGHTS; YADE's contactPoint is midway in the overlap for facets and boxes).
+        half = 0.5 * delta  # a sphere's lever arm reaches midway into the overlap (docs/law.md)
+        if not lay.s1_any:  # YADE puts the wall first: id1 the wall, id2 the sphere
+            surface = x2 - (r2 - delta)[:, None] * n
+        elif lay.s1_all:
+            surface = x1 + (r1 - delta)[:, None] * n
+        else:
+            surface = np.where(lay.s1[:, None], x1 + (r1 - delta)[:, None] * n, x2 - (r2 - delta)[:, None] * n)
+        geo["a1o"] = arm(lay.s1, lay.s1_any, lay.s1_all, r1 - half, n, surface, x1)
+        geo["a2o"] = arm(lay.s2, lay.s2_any, lay.s2_all, -(r2 - half), n, surface, x2)
+    return geo["a1o"], geo["a2o"]
+
+
+def arm(sphere, any_, all_, r, n, surface, centre):
     """Lever arm: r*n for a sphere (r: its radius less half the overlap, docs/law.md step 1),
-    else centre -> the point on the wall."""
-    if not sphere.any():
-        return to_point
-    if sphere.all():
+    else from the centre to the point on the wall's surface."""
+    if not any_:
+        return surface - centre
+    if all_:
         return r[:, None] * n
-    return np.where(sphere[:, None], r[:, None] * n, to_point)
+    return np.where(sphere[:, None], r[:, None] * n, surface - centre)
 
 
-def assemble(idx, d, dist, delta, other, g):
+def assemble(lay, d, dist, delta, g):
     """Per-contact geometry: sphere pairs from the recomputed distance (lever arms r - delta/2
-    along the normal, docs/law.md step 1), the others from with_walls."""
-    i1, i2, ss, _, r1, r2, _ = idx
-    if len(other) and len(other) == len(i1):  # no sphere pair
-        return {"i1": i1, "i2": i2, "ss": ss, "n": g["n"], "delta": g["delta"], "a1": g["a1"], "a2": g["a2"],
-                "fn": g["fn"], "other": np.asarray(other, np.int64)}
+    along the normal, docs/law.md step 1), the others from with_walls (and, one row per
+    "other" contact, their normals, overlaps and centres for `arms`)."""
+    other = lay.other
+    if not len(other):
+        z = np.zeros((0, 3))
+        g = {"n": z, "delta": np.zeros(0), "x1": z, "x2": z}
+    elif not lay.pairs:  # walls, facets, boxes only
+        return {"i1": lay.i1, "i2": lay.i2, "ss": lay.ss, "n": g["n"], "delta": g["delta"], "fn": g["fn"],
+                "other": other, "no": g["n"], "do": g["delta"], "x1o": g["x1"], "x2o": g["x2"]}
     n = d / (dist if len(dist) and dist.min() > 0 else np.where(dist > 0, dist, 1.0))[:, None]
-    fn = np.zeros(len(i1))
-    a1 = a2 = None  # sphere pairs need no arrays of lever arms (c1 n, -c2 n: see velocities, law.apply)
+    fn = np.zeros(lay.n)
     if len(other):
-        a1, a2 = (r1 - 0.5 * delta)[:, None] * n, -(r2 - 0.5 * delta)[:, None] * n
         n[other], delta[other], fn[other] = g["n"], g["delta"], g["fn"]
-        a1[other], a2[other] = g["a1"], g["a2"]
-    return {"i1": i1, "i2": i2, "ss": ss, "n": n, "delta": delta, "a1": a1, "a2": a2, "fn": fn,
-            "other": np.asarray(other, np.int64)}
+    return {"i1": lay.i1, "i2": lay.i2, "ss": lay.ss, "n": n, "delta": delta, "fn": fn, "other": other,
+            "no": g["n"], "do": g["delta"], "x1o": g["x1"], "x2o": g["x2"]}
 
 
 def join(geo, new):
     """The geometry of two lists of contacts, one after the other."""
-    new["other"] = new["other"] + len(geo["i1"])
-    out = {}
-    for k in geo:
-        a, b = geo[k], new[k]
-        if a is None and b is None:  # lever arms: none while all contacts are sphere pairs
-            out[k] = None
-            continue
-        a = np.zeros((len(geo["i1"]), 3)) if a is None else a
-        b = np.zeros((len(new["i1"]), 3)) if b is None else b
-        out[k] = np.concatenate((a, b))
+    out = {k: np.concatenate((geo[k], new[k])) for k in geo}
+    out["other"] = np.concatenate((geo["other"], new["other"] + len(geo["i1"])))
     return out
 
 
-def velocities(geo, V, W, radius, rotation, cell, shift):
+def velocities(lay, geo, V, W, radius, rotation, cell, shift):
     """Relative velocity of id1's contact point w.r.t. id2's (docs/law.md step 1; across a
-    periodic boundary id2's image also moves with the cell): (v_rel, v_n, V_s (eq. 6), the
-    cell's shift velocity or None)."""
-    i1, i2, n, delta, a1, a2 = (geo[k] for k in ("i1", "i2", "n", "delta", "a1", "a2"))
-    other = geo["other"]
+    periodic boundary id2's image also moves with the cell): (v_n, V_s (eq. 6), the cell's
+    shift velocity or None). Without rotation the spheres' spins are left out (walls,
+    facets, boxes may turn anyway)."""
+    i1, i2, n, delta = lay.i1, lay.i2, geo["n"], geo["delta"]
     v_rel = V[i1] - V[i2]
-    if rotation and not len(other) == len(i1):  # w1 x a1 - w2 x a2 = (c1 w1 + c2 w2) x n for sphere pairs
+    vo = None if lay.all_pairs else v_rel[lay.other]  # (a copy)
+    if rotation and lay.pairs:  # w1 x a1 - w2 x a2 = (c1 w1 + c2 w2) x n for sphere pairs
         # lever arms c = r - delta/2 to the contact point midway in the overlap (docs/law.md)
         half = 0.5 * delta[:, None]
         v_rel += cross((radius[i1][:, None] - half) * W[i1] + (radius[i2][:, None] - half) * W[i2], n)
-    if len(other):  # lever arms to the points that meet; walls and facets may turn
-        o1, o2 = i1[other], i2[other]
-        vo = V[o1] - V[o2]
-        for w, a, sign in ((W[o1], a1, 1.0), (W[o2], a2, -1.0)):
+        turned = True  # (v_rel's "other" rows are to be put back)
+    else:
+        turned = False
+    if vo is not None:  # lever arms to the points that meet; walls and facets may turn
+        for side, o, sphere, any_, all_, sign in ((0, lay.o1, lay.s1, lay.s1_any, lay.s1_all, 1.0),
+                                                  (1, lay.o2, lay.s2, lay.s2_any, lay.s2_all, -1.0)):
+            if rotation or not any_:
+                w = W[o]
+            elif all_:
+                continue  # (a sphere's spin is left out: no term)
+            else:
+                w = np.where(sphere[:, None], 0.0, W[o])
             if w.any():
-                vo += sign * cross(w, a[other])
-        v_rel[other] = vo
+                vo += sign * cross(w, arms(lay, geo)[side])
+                turned = True
+        if turned:
+            v_rel[lay.other] = vo
     sv = None
     if shift is not None:
         sv = cell @ shift[1].T
         v_rel -= sv
     v_n = dot(v_rel, n)
     V_s = v_rel - v_n[:, None] * n
-    return v_rel, v_n, V_s, sv
+    return v_n, V_s, sv
 
 
-def sphere_pair_fn(geo, fn, kn, cn, v_n, sv):
+def sphere_pair_fn(lay, geo, kn, cn, v_n, sv):
     """Eq. 3 as YADE's native law computes it for the sphere pairs (kn, cn: each contact's,
     read from YADE when it was made), never tensile; the other contacts keep YADE's Fn."""
-    ss, n, delta = geo["ss"], geo["n"], geo["delta"]
+    n, delta = geo["n"], geo["delta"]
     v_fn = v_n
     if sv is not None:
         # YADE 2023.02a's Law2_ScGeom_ViscElPhys_Basic adds the cell's shift velocity
@@ -150,10 +201,12 @@ def sphere_pair_fn(geo, fn, kn, cn, v_n, sv):
         # the force applied); V_s uses the true relative velocity (measured: the
         # overlap grows at 1.99e-4 m/s where YADE's dashpot sees -1.80e-3 m/s).
         v_fn = v_n + 2.0 * dot(sv, n)
-    if not len(geo["other"]):  # all sphere pairs (no masks: they copy)
-        return np.maximum(0.0, kn * delta + cn * v_fn)
-    fn[ss] = np.maximum(0.0, kn[ss] * delta[ss] + cn[ss] * v_fn[ss])
-    return fn
+    fn = np.maximum(0.0, kn * delta + cn * v_fn)
+    if lay.all_pairs:
+        return fn
+    out = geo["fn"]
+    out[lay.ss] = fn[lay.ss]
+    return out
 
 
 def same_as_yade(O, geo, fn):

@@ -86,8 +86,7 @@ class StickSlipLaw:
             continuing = False
         bodies = self.bodies
         engines = O.engines
-        if self.validated is None or len(engines) != len(self.validated) or not all(
-                a == b for a, b in zip(engines, self.validated)):
+        if self.validated is None or engines != self.validated:  # (Serializable ==: the same C++ object)
             checks.validate_scene(engines, self.token, bodies)
             self.validated = list(engines)
         self.last_iter = it
@@ -96,8 +95,6 @@ class StickSlipLaw:
         dt = 0.0 if self.setup_step else O.dt
         self.setup_step = False
         P, V, W = bodies.states_now(it)
-        if not self.rotation:
-            W = np.where(bodies.sphere[:, None], 0.0, W)  # walls, facets, boxes may turn anyway
         shift = cell_motion(O)
 
         c = self.contacts
@@ -109,10 +106,11 @@ class StickSlipLaw:
             if O.trackEnergy:
                 energy.book(O, 0.0, 0.0, 0.0, 0.0, 0.0)
             return
-        i1, i2, n, delta, fn = (geo[k] for k in ("i1", "i2", "n", "delta", "fn"))
-        v_rel, v_n, V_s, sv = geometry.velocities(geo, V, W, bodies.radius, self.rotation, c.cell, shift)
-        if len(geo["other"]) < len(i1):
-            fn = geometry.sphere_pair_fn(geo, fn, c.kn, c.cn, v_n, sv)
+        lay = c.index(bodies)  # (the rows of geo)
+        i1, i2, n, delta, fn = lay.i1, lay.i2, geo["n"], geo["delta"], geo["fn"]
+        v_n, V_s, sv = geometry.velocities(lay, geo, V, W, bodies.radius, self.rotation, c.cell, shift)
+        if lay.pairs:
+            fn = geometry.sphere_pair_fn(lay, geo, c.kn, c.cn, v_n, sv)
         if self.check:
             err, k = geometry.same_as_yade(O, geo, fn)
             self.max_fn_error, self.checked = max(self.max_fn_error, err), self.checked + k
@@ -136,15 +134,16 @@ class StickSlipLaw:
         if book:
             self.min_dissipation = min(self.min_dissipation,
                                        energy.book_step(O, tan, self.ks, c.kn, delta, fn, v_n, dt))
-        self._apply(O, geo, F_s)
+        self._apply(O, lay, geo, F_s)
 
-    def _apply(self, O, geo, F_s):
-        """Forces and torques summed per body, then one addF (and addT) per body that gets any."""
-        i1, i2, n, a1, a2, other, delta = (geo[k] for k in ("i1", "i2", "n", "a1", "a2", "other", "delta"))
+    def _apply(self, O, lay, geo, F_s):
+        """Forces and torques summed per body (in contact order: one bincount over the flat
+        components), then one addF (and addT) per body that gets any."""
+        i1, i2, n, delta, other = lay.i1, lay.i2, geo["n"], geo["delta"], lay.other
         nb = self.bodies.n
-        F = np.empty((nb, 3))
-        for c in range(3):
-            F[:, c] = np.bincount(i1, F_s[:, c], nb) - np.bincount(i2, F_s[:, c], nb)
+        f1, f2 = lay.flat()
+        flat = F_s.ravel()
+        F = (np.bincount(f1, flat, 3 * nb) - np.bincount(f2, flat, 3 * nb)).reshape(nb, 3)
         if not self.rotation:
             got = np.flatnonzero(F.any(axis=1))
             list(map(O.forces.addF, got.tolist(), F[got].tolist(), repeat(False)))
@@ -156,11 +155,10 @@ class StickSlipLaw:
         t1 = (radius[i1] - 0.5 * delta)[:, None] * nF
         t2 = (radius[i2] - 0.5 * delta)[:, None] * nF
         if len(other):
-            t1[other] = cross(a1[other], F_s[other])
-            t2[other] = -cross(a2[other], F_s[other])
-        T = np.empty((nb, 3))
-        for c in range(3):
-            T[:, c] = np.bincount(i1, t1[:, c], nb) + np.bincount(i2, t2[:, c], nb)
+            a1, a2 = geometry.arms(lay, geo)
+            t1[other] = cross(a1, F_s[other])
+            t2[other] = -cross(a2, F_s[other])
+        T = (np.bincount(f1, t1.ravel(), 3 * nb) + np.bincount(f2, t2.ravel(), 3 * nb)).reshape(nb, 3)
         got = np.flatnonzero(F.any(axis=1) | T.any(axis=1))
         if len(got) == nb:  # every body: no copies
             ids, F, T = range(nb), F.tolist(), T.tolist()
@@ -190,6 +188,13 @@ class StickSlipLaw:
         if p is None:
             return None
         return float(c.fn[p]), c.F_s[p].copy(), bool(c.slipped[p]), int(c.count[p])
+
+    def has_slipped(self, id1, id2):
+        """True if the contact (id1, id2) touches and slipped in the last step (cheaper than
+        contact(): what run_scene.py asks every step)."""
+        c = self.contacts
+        p = c.row(key(int(id1), int(id2)) if id1 < id2 else key(int(id2), int(id1)))
+        return p is not None and bool(c.slipped[p])
 
     def lookup(self, id1, id2):
         """(Fn, F_s on id1, slipped this step) or None (what run_scene.py reads)."""

@@ -1,18 +1,17 @@
 """The PyRunner that runs the law each step, between YADE's InteractionLoop and
 NewtonIntegrator, and what its command calls.
 
-The command does not rely on a name defined by the user's script: it imports stickslip_yade
-from its own folder if the process has not (a scene loaded by O.load in a new process), and
-the law named by its token is rebuilt there from the parameters saved with the scene
-(checkpoints.py) and published as `builtins.stickslip_law`.
+While the law runs, its runner's command is `_stickslip_step(token)` (this module puts the
+name in builtins: a PyRunner's command runs in __main__, and it is compiled every step, so
+it is kept short). A saved scene carries a robust command instead (checkpoints.py), which
+needs no name from the user's script: it imports stickslip_yade from its own folder if the
+process has not (O.load in a new process), where the law named by its token is rebuilt from
+the parameters saved with the scene and published as `builtins.stickslip_law`.
 """
 import builtins
-import os
 
 from . import checkpoints
 from .law import StickSlipLaw
-
-HERE = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # yade_law/, where stickslip_yade is found
 
 
 def step(token):
@@ -21,6 +20,20 @@ def step(token):
     if law is None:
         law = law_from_scene(token)
     law.step()
+
+
+builtins._stickslip_step = step  # the short command's name
+
+
+def resume(token):
+    """What a saved scene's runner runs (checkpoints.robust_command): the law's step, then the
+    runner gets the short command for the steps that follow."""
+    from yade import O, PyRunner
+
+    step(token)
+    for e in O.engines:
+        if isinstance(e, PyRunner) and checkpoints.token_of(e.command) == token:
+            e.command = checkpoints.short_command(token)
 
 
 def law_from_scene(token):
@@ -45,14 +58,6 @@ def publish(law):
     builtins.stickslip_law = law
 
 
-def command(token):
-    """One expression, compiled by PyRunner every step (so kept short): this module, imported
-    from its own folder if the process has not imported it yet (O.load in a new process),
-    runs the law named by `token`."""
-    return (f"(__import__('sys').modules.get('stickslip_yade') or (__import__('sys').path.append({HERE!r}), "
-            f"__import__('stickslip_yade'))[1]).step({token!r})")
-
-
 def stickslip_runner(ks, nu_s, mu_s, mu_k, reset="spring", slip_timing="step", rotation=True, check=False):
     """The law's PyRunner, for an engine list of your own: place it right after the
     InteractionLoop and before NewtonIntegrator (yade_law/README.md, "Your own engine list").
@@ -62,5 +67,5 @@ def stickslip_runner(ks, nu_s, mu_s, mu_k, reset="spring", slip_timing="step", r
     law = StickSlipLaw(ks, nu_s, mu_s, mu_k, reset, slip_timing, rotation=rotation, check=check)
     publish(law)
     # initRun=True: otherwise the first step runs without the tangential force.
-    return PyRunner(command=command(law.token), iterPeriod=1, initRun=True, updateGlobals=False,
+    return PyRunner(command=checkpoints.short_command(law.token), iterPeriod=1, initRun=True, updateGlobals=False,
                     label="stickslip_runner")
