@@ -294,6 +294,10 @@ def test_drum_on_yade_is_pyrefs_in_free_fall(tmp_path):
         vel = [f"{g}_v{axis}" for g in sc.output.grains]
         assert np.abs(dy[pos].to_numpy() - dp[pos].to_numpy()).max() < 1e-14, axis
         assert np.abs(dy[vel].to_numpy() - dp[vel].to_numpy()).max() < 1e-14, axis
+    # the kinetic energy from those velocities (YADE: the mean of its half-step ones), to twice
+    # their relative round-off, 1e-14 m/s against speeds of g t >= 0.0098 m/s after the start
+    np.testing.assert_allclose(dy["ekin"], dp["ekin"], rtol=2 * 1e-14 / 0.0098, atol=0)
+    assert (dy["n_contacts"] == dp["n_contacts"]).all() and (dy[list(columns.SLIP_STATS)] == 0).all().all()
     fall = 0.5 * 9.81 * 0.005**2  # m: the fall is there (1.2e-4 m), far above round-off
     assert (dp[[f"{g}_y" for g in sc.output.grains]].iloc[0] - dp[[f"{g}_y" for g in sc.output.grains]].iloc[-1]
             ).min() > 0.9 * fall

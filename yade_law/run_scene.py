@@ -104,7 +104,6 @@ class TurningWall:
         s.vel = self.velocity + s.angVel.cross(s.pos - self.pivot)
 
 
-
 def gravity_at(sc, t):
     """The scene's gravity turned about z by its angle at t (stickslip Scene.gravity_angle:
     the same arithmetic)."""
@@ -197,13 +196,13 @@ def main(scene_path, out_path):
             r += [rot["rate"] * dt * min(step, rot["steps"]) if rot else 0.0]
         if out["stats"]:
             # kinetic energy at t (translation and spin): each body's mean of its velocities at
-            # t - dt/2 and t + dt/2
+            # t - dt/2 and t + dt/2 (row 0: the velocities given)
             ek = 0.0
             for b in O.bodies:
                 if b.dynamic:
                     s = b.state
                     v0, w0 = kin[1][b.id]
-                    v, w = 0.5 * (v0 + s.vel), 0.5 * (w0 + s.angVel)
+                    v, w = (0.5 * (v0 + s.vel), 0.5 * (w0 + s.angVel)) if step else (v0, w0)
                     ek += 0.5 * (s.mass * v.squaredNorm() + sum(s.inertia[q] * w[q] ** 2 for q in range(3)))
             r += [len(law.keys), ek]
         if out.get("slip_stats"):
