@@ -1,7 +1,7 @@
 """The contact laws of Khellaf & Mansouri (2024), vectorised over contacts.
 
 This is the one numpy kernel of the law: pyref and the YADE law both call it
-(yade_law/stickslip_yade.py imports this file). It follows docs/law.md line by
+(yade_law/stickslip_yade/kernel.py imports this file). It follows docs/law.md line by
 line. Arrays have one row per contact; vectors are (K, 3). It needs numpy only.
 Sign convention: forces are those acting on grain i; `V_s` is the tangential
 velocity of i's contact point relative to j's, so friction opposes it.

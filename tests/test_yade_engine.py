@@ -45,7 +45,8 @@ def test_the_yade_law_uses_the_one_numpy_kernel():
 
     assert stickslip_yade.tangential_force is pyref.laws.tangential_force
     assert stickslip_yade.rotate_history is pyref.laws.rotate_history
-    src = (ROOT / "yade_law" / "stickslip_yade.py").read_text()
+    src = "".join(p.read_text() for p in (ROOT / "yade_law" / "stickslip_yade").glob("*.py"))
+    assert "tangential_force(" in src
     for copy_of_kernel in ("f_min / np.maximum(mag", "2.0 * mu_k - mu_s) * fn", "scale = np.sqrt(old /"):
         assert copy_of_kernel not in src
 
@@ -79,85 +80,84 @@ def _pyref_exact(name):
     return run_pyref(scene_mod.load(name, slip_timing="exact"))[0]
 
 
+U = np.finfo(float).eps / 2  # unit round-off, 1.1e-16
+BOX_HALF_THICKNESS = 0.01  # m: run_scene.py builds a turning wall as a box this thick
+
+
+def assert_round_off_apart(sc, dy, dp):
+    """YADE against pyref row by row, every column. Since issue 25 YADE starts as velocity
+    Verlet (yade_law/README.md, "Twin runs"), so both engines do the same arithmetic step
+    for step, in another order: they may differ by round-off only. Bound: at each step an
+    engine may round a coordinate differently, by u L (L: the largest coordinate a contact
+    is computed from: the grains', or the centre of a turning wall's box), and an overlap
+    by up to 4 u L more (a box turns the sphere's offset into its frame); the dynamics is
+    stable and dissipative, so such errors add up without growing (a perturbed oscillator
+    keeps its perturbation's amplitude): after k steps positions differ by at most
+    dx = (k + 4) u L and velocities by dv = w dx, w = sqrt((Kn + Ks)/m_eff) the fastest contact
+    frequency (m_eff: half the lightest grain); normal forces by Kn dx + nu_n dv, tangential
+    ones by Ks dx + nu_s dv, and slips fall in the same steps (a slip moves only if the
+    trial force ends a step within ~Ks dx of mu_s Fn; it changes by Ks |V_s| dt, 1e5 times
+    more, per step). The wall angles and times are computed by the same formula: equal.
+    The differences this replaced (YADE's whole first kick, its springs loaded at setup,
+    rows written a step early, a turning box's velocities) broke these bounds in every
+    column they touched, by 25 to 5e6 times (measured on the code before issue 25: the
+    drag's Fn 2.3e4 times, the tilt's x 3.5e5 times)."""
+    assert list(dy.columns) == list(dp.columns) and len(dy) == len(dp)
+    c = sc.contact
+    k = (dp["t"].to_numpy() / sc.dt).round()  # steps made by each row
+    L = max(max(np.abs(dp[[col for col in dp.columns if col.endswith(("_x", "_y", "_z"))]].to_numpy()).max(), 0.0),
+            BOX_HALF_THICKNESS if any(w.rotation for w in sc.walls) else 0.0)
+    m_eff = min(sc.grain_mass(g) for g in sc.grains) / 2
+    dx = (k + 4) * U * L
+    dv = math.sqrt((c.kn + c.ks) / m_eff) * dx
+    nu_n = c.nu_n if sc.effects["normal_damping"] else 0.0
+    nu_s = c.nu_s if sc.effects["tangential_damping"] else 0.0
+    for col in dp.columns:
+        y, p = dy[col].to_numpy(), dp[col].to_numpy()
+        if col == "t" or col.endswith(("_slip", "_angle")):
+            bound = np.zeros_like(k)
+        elif col.endswith(("_x", "_y", "_z")):
+            bound = dx
+        elif col.endswith(("_vx", "_vy", "_vz")):
+            bound = dv
+        elif col.endswith("_fn"):
+            bound = c.kn * dx + nu_n * dv
+        elif col.endswith(("_fs", "_ftx", "_fty", "_ftz")):
+            bound = c.ks * dx + nu_s * dv
+        else:
+            raise AssertionError(f"no bound for column {col}")
+        worst = int(np.argmax(np.abs(y - p) - bound))
+        assert np.all(np.abs(y - p) <= bound), (col, worst, y[worst], p[worst], bound[worst])
+
+
 @needs_yade
 @pytest.mark.parametrize("timing", ["step", "exact"])
-def test_drag_matches_pyref(tmp_path, timing):
+def test_drag_is_pyrefs_twin(tmp_path, timing):
+    """Every row of the drag (2500 steps, every = 1) within round-off of pyref's."""
     sc, dy = run_yade("drag", tmp_path, slip_timing=timing)
-    dp = pyref_case("drag", timing)
-    sy, sp = analysis.summarise(sc, dy), analysis.summarise(sc, dp)
-    for k in ("fs_fn_max", "fs_fn_min", "fs_fn_mean", "slip_period_s"):
-        assert sy[k] == pytest.approx(sp[k], rel=0.01), k
-    assert sy["slip_count"] == sp["slip_count"]
-    # Time series. The drive is imposed, so while sticking Fs = Ks*D + nu_s*V is the same
-    # in both; they differ only through Fn, which starts differently (pyref's velocity
-    # Verlet gives the first step half a gravity kick, YADE's leapfrog a whole one): a
-    # normal oscillation of amplitude g*dt/(2 w_n), i.e. dFn <= Kn*g*dt/(2 w_n), which
-    # enters Fs at slips through Fmin = (2 mu_k - mu_s) Fn. Row 0 (no force yet in YADE)
-    # is left out.
-    c = "grain-floor"
-    m = sc.grain_mass(sc.grains[0])
-    w_n = math.sqrt(sc.contact.kn / m)
-    dfn_bound = sc.contact.kn * 9.81 * sc.dt / (2 * w_n)
-    dfn = np.abs(dy[f"{c}_fn"] - dp[f"{c}_fn"]).to_numpy()[1:]
-    dfs = np.abs(dy[f"{c}_fs"] - dp[f"{c}_fs"]).to_numpy()[1:]
-    assert dfn.max() <= dfn_bound
-    slip_y, slip_p = dy[f"{c}_slip"].to_numpy() > 0, dp[f"{c}_slip"].to_numpy() > 0
-    if timing == "step":
-        assert (slip_y == slip_p).all()
-    else:
-        # Exact mode: a slip happens when the force, growing by Ks*V per second, reaches
-        # mu_s*Fn, so the engines' Fn difference moves its instant by mu_s*dFn/(Ks*V): a
-        # slip that close to the end of a step may fall at the start of the next one in the
-        # other engine. With the measured dFn that is under one step, so slips pair up
-        # within one row.
-        shift = sc.contact.mu_s * dfn.max() / (sc.contact.ks * 1e-5 * sc.dt)  # in steps (V = 1e-5 m/s)
-        assert shift < 1
-        rows_y, rows_p = np.flatnonzero(slip_y), np.flatnonzero(slip_p)
-        assert len(rows_y) == len(rows_p) and np.abs(rows_y - rows_p).max() <= 1
-    # Where both engines slipped or stuck alike, Fs differs only through Fmin: in the step
-    # mode by (2 mu_k - mu_s)*dFn; in the exact mode a step with a slip ends at
-    # Fmin + kept + rate*(1 - theta) with theta = (mu_s*Fn - F_0)/rate, so by
-    # 2(mu_s - mu_k)*dFn, smaller here.
-    alike = (slip_y == slip_p)[1:]
-    assert dfs[alike].max() <= (2 * sc.contact.mu_k - sc.contact.mu_s) * dfn_bound + 1e-12
+    assert_round_off_apart(sc, dy, pyref_case("drag", timing))
+    assert dy["grain-floor_slip"].sum() >= 5  # the saw-tooth is there
 
 
 @needs_yade
 @pytest.mark.parametrize("timing", ["step", "exact"])
-def test_tilt_matches_pyref(tmp_path, timing):
+def test_tilt_is_pyrefs_twin(tmp_path, timing):
+    """Every row of the tilt (1 s, 125 000 steps: the plate turning and stopping, the stick,
+    stick-slip and sliding phases) within round-off of pyref's."""
     sc, dy = run_yade("tilt", tmp_path, slip_timing=timing)
-    dp = pyref_case("tilt", timing)
-    sy, sp = analysis.summarise(sc, dy), analysis.summarise(sc, dp)
-    for k in ("tan_beta_first_slip", "accel_steady_mps2"):
-        assert sy[k] == pytest.approx(sp[k], rel=0.01), k
-    # The mean acceleration of the stick-slip phase is its speed gain over its duration
-    # (3 ms step, 17 ms exact); it starts at the first slip and ends where the friction
-    # stays at Fmin, both of which the engines place a few steps apart (below). Moving an
-    # end by dt' changes the mean by at most (a_end/a_mean) dt'/duration, a_end <= the
-    # steady acceleration: 1 % plus that for both ends.
-    shifts = abs(sy["t_first_slip_s"] - sp["t_first_slip_s"]) + abs(sy["t_steady_s"] - sp["t_steady_s"])
-    tol = 0.01 + sp["accel_steady_expected_mps2"] / sp["accel_stick_slip_mps2"] * shifts / sp["stick_slip_duration_s"]
-    assert sy["accel_stick_slip_mps2"] == pytest.approx(sp["accel_stick_slip_mps2"], rel=tol)
-    # The speed down the plate after the first slip: the engines start from different
-    # half-kicks and their first slips fall a few steps apart (t_first_slip differs by
-    # dt-multiples), so compare the histories to the velocity gained in those steps:
-    # a*Δt with a <= the steady acceleration and Δt = |Δt_first_slip| + 2 rows.
-    beta_p, beta_y = dp["plate_angle"], dy["plate_angle"]
-    up = -(dp["grain_vx"] * np.cos(beta_p) + dp["grain_vy"] * np.sin(beta_p))
-    uy = -(dy["grain_vx"] * np.cos(beta_y) + dy["grain_vy"] * np.sin(beta_y))
-    lag = abs(sy["t_first_slip_s"] - sp["t_first_slip_s"]) + 2 * sc.output.every * sc.dt
-    assert np.abs(uy - up).max() <= sp["accel_steady_expected_mps2"] * lag * 1.5
+    assert_round_off_apart(sc, dy, pyref_case("tilt", timing))
+    assert dy["grain-plate_slip"].sum() > 100
 
 
 @needs_yade
-def test_tray_stick_slip_holds_grain_1_as_in_pyref(tmp_path):
+def test_tray_is_pyrefs_twin(tmp_path):
+    """The tray's first 0.5 s (the impact, whose slips fix the grain-grain friction that
+    holds grain 1 up; grain 1 touches the left wall at zero overlap for its first steps,
+    no contact in either engine) within round-off of pyref's, and grain 1 held up."""
     sc, dy = run_yade("tray", tmp_path, duration=0.5)
     _, dp, _ = paper_case("tray", duration=0.5)
-    sy, sp = analysis.summarise(sc, dy), analysis.summarise(sc, dp)
-    assert not sy["reached_bottom"]
-    # Height above the bottom (grain 1 rests 0.1 mm up): within 1 %.
-    r = sc.grains[0].radius
-    assert sy["y1_final_m"] - r == pytest.approx(sp["y1_final_m"] - r, rel=0.01)
+    assert_round_off_apart(sc, dy, dp)
+    assert not analysis.summarise(sc, dy)["reached_bottom"]
 
 
 @needs_yade

@@ -180,3 +180,41 @@ def test_runner_records_only_what_output_asks_for(tmp_path):
     lines = (tmp_path / "out.csv").read_text().splitlines()
     # 2e-4 s at dt = 2e-6 s: 100 steps, a row every 25 steps and the start; only time asked.
     assert lines[0] == "t" and len(lines) == 1 + 100 // 25 + 1
+
+
+START = """
+import json, sys
+sys.path.insert(0, %r)
+from stickslip_yade import stickslip_engines, stickslip_material, velocity_verlet_start
+from yade import O, utils
+case = sys.argv[1]
+mat = O.materials.append(stickslip_material(1e4, 0.1))
+O.bodies.append(utils.wall(0.0, axis=2, material=mat))
+O.bodies.append(utils.sphere((0, 0, 0.0019), 0.002, material=mat))
+if case == "clump":
+    O.bodies.appendClumped([utils.sphere((0.01, 0, 0.003), 0.002, material=mat),
+                            utils.sphere((0.013, 0, 0.003), 0.002, material=mat)])
+O.engines = stickslip_engines(ks=8e3, nu_s=0.1, mu_s=0.5, mu_k=0.45, gravity=(0, 0, -9.81))
+O.dt = 1e-5
+if case == "late":
+    O.step()
+try:
+    velocity_verlet_start()
+    out = None
+except (RuntimeError, ValueError) as e:
+    out = [type(e).__name__, str(e)]
+print("RESULT " + json.dumps(out))
+"""
+
+
+@pytest.mark.parametrize("case,words", [
+    ("late", ["RuntimeError", "velocity_verlet_start", "iteration 1", "starts a run (iteration 0)"]),
+    ("clump", ["ValueError", "velocity_verlet_start", "is not a free sphere"]),
+])
+def test_velocity_verlet_start_refuses_what_it_cannot_start(tmp_path, case, words):
+    """velocity_verlet_start (yade_law/README.md, "Twin runs") starts a run of free spheres:
+    called after the first step, or with a clump, it says so in one line."""
+    got = yade(tmp_path, START % str(LAW), case)
+    assert got is not None, case
+    for w in words:
+        assert w in " ".join(got), got

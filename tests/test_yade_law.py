@@ -1,4 +1,4 @@
-"""The Python stick-slip law inside YADE (yade_law/stickslip_yade.py), driven as
+"""The Python stick-slip law inside YADE (yade_law/stickslip_yade/), driven as
 `yade -n -x` subprocesses. Expected values are derived from the law (docs/law.md)
 and the parameters; tolerances come from the time step (a slip is detected on the
 first step the trial force reaches mu_s*Fn, so times are known to one step).

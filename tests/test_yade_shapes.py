@@ -249,15 +249,16 @@ def derive(example, replacements, steps, law, checks, before=r"NewtonIntegrator\
 import math as _m, builtins as _b  # (examples do `from numpy import *`, which shadows sum and all)
 _n = len(O.bodies)
 _e0 = _b.sum(b.state.mass * 10.0 * (b.state.pos[{checks['up']}] - {checks['bottom']}) for b in O.bodies if b.dynamic)
-_ek, _most = [], 0
+_ek, _most, _slips = [], 0, 0
 for _k in range({steps}):
     O.step()
     _most = max(_most, stickslip_law.n_contacts())
+    _slips += int(stickslip_law.slipped.sum())
     if _k % 50 == 0:
         _ek.append(_b.sum(0.5 * b.state.mass * b.state.vel.squaredNorm() for b in O.bodies if b.dynamic))
 _pos = [list(b.state.pos) for b in O.bodies if b is not None and b.dynamic and not b.isClump]
 print("RESULT " + json.dumps({{"n0": _n, "n": len([b for b in O.bodies if b is not None]), "pos": _pos,
-      "ek": _ek, "e0": _e0, "slips": int(stickslip_law.count.sum()), "contacts": _most,
+      "ek": _ek, "e0": _e0, "slips": _slips, "contacts": _most,
       "finite": _b.all(_m.isfinite(x) for p in _pos for x in p), "iter": O.iter}}))
 """
     return head + text + tail
@@ -274,7 +275,10 @@ def test_shipped_examples_run_with_the_law(tmp_path, example):
     its own); the sand pile's FrictMat becomes a stickslip_material of the same normal
     stiffness, kn = E r = 100 N/m, and its time stepper a fixed dt (0.1 sqrt(m/kn)); the law
     gets the examples' friction coefficient (tan 35 deg, tan 30 deg), mu_k = 0.9 mu_s.
-    Checked: no error, no lost, escaped or non-finite body, contacts that slipped, and
+    Checked: no error, no lost, escaped or non-finite body, slips (over 100 contact-steps that
+    slipped in the run; contacts at zero or negative overlap, which YADE keeps with facets,
+    are no contacts for the law and do not count: in clump-inbox they were 32 000 of the
+    32 300 slips the law counted before issue 25), and
     kinetic energy below what the bodies started with plus the potential energy of their
     fall to the container's bottom."""
     if not EXAMPLES.is_dir():

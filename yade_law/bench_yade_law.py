@@ -8,7 +8,7 @@ Builds an n x n x n cubic lattice of overlapping spheres (3 n^2 (n-1) contacts,
 keeps every contact; 0.05 opens and closes contacts during the run), then, several
 times over and interleaved (so that a busy machine slows all three alike):
   A. native: ViscElMat with ks > 0 and friction, Law2_ScGeom_ViscElPhys_Basic;
-  B. stick-slip: the native normal force + the PyRunner law (stickslip_yade.py);
+  B. stick-slip: the native normal force + the PyRunner law (yade_law/stickslip_yade/);
   C. normal only: B without the PyRunner (ks = 0, no friction), to isolate the law.
 The whole step is timed in CPU time of the thread running it (time.thread_time around
 O.step: the figure a user feels, less the time other processes took the core); the law's
