@@ -56,3 +56,25 @@ def test_a_run_asked_for_twice_runs_once(monkeypatch, tmp_path):
     assert (tmp_path / "rung" / "timeseries.csv").read_bytes() == (tmp_path / "case" / "timeseries.csv").read_bytes()
     assert got[1][1] == got[0][1] and got[1][2].equals(got[0][2])
     assert got[2][1]["dt_s"] == dt / 2 and got[2][1]["steps"] == 2 * got[0][1]["steps"]
+
+
+def test_bench_report_gives_the_reports_time_and_where_it_went(monkeypatch):
+    """`stickslip bench --report`: the report's wall time, its runs' CPU time and the share
+    of each part (here a report that logs two tasks, without running them)."""
+    from stickslip import bench
+
+    tray = runner.task("tray", "pyref", "unused", law="coulomb", slip_timing="step")
+    rung = runner.task("tilt", "pyref", "unused", dt=4e-6, slip_timing="exact", duration=None)
+    drag = (1.0, mean_friction, ("drag", 1e-3, 2e-6, "step"))
+
+    def fake_report(out, progress=True, cpu_log=None):
+        cpu_log += [(tray, 30.0), (rung, 20.0), (drag, 1.5)]
+
+    monkeypatch.setattr(report, "build_report", fake_report)
+    rows = {r["case"]: r["value"] for r in bench.report_rows()}
+    (wall,) = [v for k, v in rows.items() if k.startswith("stickslip report, wall time s")]
+    assert 0 <= wall < 5
+    assert rows["CPU s of all its runs"] == 51.5
+    assert rows["CPU s: case tray on pyref"] == 30.0 and rows["CPU s: ladder tilt on pyref"] == 20.0
+    assert rows["CPU s: friction_speed"] == 1.5
+    assert rows["CPU s of its longest run (case tray on pyref)"] == 30.0
