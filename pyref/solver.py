@@ -104,6 +104,7 @@ class Simulation:
         self.wall_rate = [s.rotation_rate(w) if w.rotation else 0.0 for w in s.walls]
         # Fixed walls: points, normals, rates and offsets p.n never change.
         self.fixed_walls = (self.wall_p0, self.wall_n0, np.zeros(self.W), np.sum(self.wall_p0 * self.wall_n0, axis=1))
+        self.turning_walls = [k for k, w in enumerate(s.walls) if w.rotation]
         self.wall_turn = [_Rotation(w.rotation.axis) if w.rotation else None for w in s.walls]
         self.step_no = 0
 
@@ -137,16 +138,14 @@ class Simulation:
         during the last step."""
         if not self.moving_walls:
             return self.fixed_walls
-        p, n = self.wall_p0.copy(), self.wall_n0.copy()
+        p, n = self.wall_p0 + self.wall_v * self.step_no * self.dt, self.wall_n0.copy()
         rates = np.zeros(self.W)
-        for k, w in enumerate(self.walls):
-            p[k] = p[k] + w.velocity * self.step_no * self.dt
-            if w.rotation:
-                nrot = self.wall_rot_steps[k]
-                R = self.wall_turn[k].matrix(self.wall_rate[k] * self.dt * min(self.step_no, nrot))
-                p[k] = w.rotation.pivot + R @ (p[k] - w.rotation.pivot)
-                n[k] = R @ n[k]
-                rates[k] = self.wall_rate[k] if 1 <= self.step_no <= nrot else 0.0
+        for k in self.turning_walls:
+            rot, nrot = self.walls[k].rotation, self.wall_rot_steps[k]
+            R = self.wall_turn[k].matrix(self.wall_rate[k] * self.dt * min(self.step_no, nrot))
+            p[k] = rot.pivot + R @ (p[k] - rot.pivot)
+            n[k] = R @ n[k]
+            rates[k] = self.wall_rate[k] if 1 <= self.step_no <= nrot else 0.0
         return p, n, rates, (p * n).sum(axis=1)
 
     def _wall_velocity(self, wk, cp, rates):
@@ -481,14 +480,14 @@ class Simulation:
         return self.recording(steps, time.perf_counter() - t0)
 
 
+# Component k of a x b is a[k+1] b[k+2] - a[k+2] b[k+1] (indices mod 3).
+_NEXT, _AFTER_NEXT = np.array([1, 2, 0]), np.array([2, 0, 1])
+
+
 def _cross(a, b):
     """Row-wise cross product of (K, 3) arrays (np.cross, without its axis juggling);
     `a` may be a single row, broadcast over b's."""
-    out = np.empty((len(b), 3))
-    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return out
+    return a.take(_NEXT, 1) * b.take(_AFTER_NEXT, 1) - a.take(_AFTER_NEXT, 1) * b.take(_NEXT, 1)
 
 
 def _all_finite(a):
