@@ -200,7 +200,7 @@ class Simulation:
             d = self.x.take(b, 0) - self.x.take(a, 0)
             dist = np.sqrt(_dot(d, d))
             delta = reach - dist
-            touching = delta > 0
+            touching = delta > 0.0
             P = np.count_nonzero(touching)
             if P:
                 if P < len(touching):
@@ -210,7 +210,7 @@ class Simulation:
         if W:
             p, n, rates, offset = self._wall_state()
             delta = self.r_col - (self.x @ n.T - offset)
-            gi, wk = np.nonzero(delta > 0)
+            gi, wk = (delta > 0.0).nonzero()
             if len(gi):
                 dw = delta[gi, wk]
                 n_w = n.take(wk, 0)
