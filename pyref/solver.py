@@ -16,6 +16,7 @@ import numpy as np
 from .laws import _dot, normal_force, rotate_history, tangential_force
 
 PAIR_BRUTE_FORCE_MAX = 64  # below this many grains, test every pair (no tree)
+SCATTER_ADD_AT_MAX = 64  # up to this many contact rows np.add.at sums forces faster than np.bincount
 
 
 class Contacts(NamedTuple):
@@ -89,6 +90,10 @@ class Simulation:
         self.any_imposed = bool(self.imposed.any())
         self.g = s.gravity if self.gravity_on else np.zeros(3)
         self.turning_gravity = self.gravity_on and bool(s.gravity_rate or s.gravity_spinup[1])
+        # Per-step constants, computed once (the same numbers the step would compute).
+        self.half_dt = 0.5 * self.dt
+        self.m_col, self.inertia_col, self.r_col = self.m[:, None], self.inertia[:, None], self.r[:, None]
+        self.weight = self.m_col * self.g
 
         self.walls = s.walls
         self.W = len(s.walls)
@@ -97,12 +102,16 @@ class Simulation:
         self.wall_v = np.array([w.velocity for w in s.walls]).reshape(-1, 3)
         self.wall_rot_steps = [s.rotation_steps(w) if w.rotation else 0 for w in s.walls]
         self.wall_rate = [s.rotation_rate(w) if w.rotation else 0.0 for w in s.walls]
+        # Fixed walls: points, normals, rates and offsets p.n never change.
+        self.fixed_walls = (self.wall_p0, self.wall_n0, np.zeros(self.W), np.sum(self.wall_p0 * self.wall_n0, axis=1))
+        self.turning_walls = [k for k, w in enumerate(s.walls) if w.rotation]
+        self.wall_turn = [_Rotation(w.rotation.axis) if w.rotation else None for w in s.walls]
         self.step_no = 0
 
         # Contact state, kept sorted by key = i*(N+W) + j, j = grain index or N + wall.
         self.keys = np.zeros(0, np.int64)
         self.D = np.zeros((0, 3))
-        self.pairs = None
+        self.pairs = None  # candidate pairs: (a, b, r_a + r_b), a < b
         self.x_at_build = None
         self.skin = 0.2 * float(self.r.min())
 
@@ -125,29 +134,27 @@ class Simulation:
 
     # ------------------------------------------------------------ walls
     def _wall_state(self):
-        """Wall points and normals at the current time, and angular rates during the last step."""
+        """Wall points, normals and offsets p.n at the current time, and angular rates
+        during the last step."""
         if not self.moving_walls:
-            return self.wall_p0, self.wall_n0, np.zeros(self.W)
-        p, n = self.wall_p0.copy(), self.wall_n0.copy()
+            return self.fixed_walls
+        p, n = self.wall_p0 + self.wall_v * self.step_no * self.dt, self.wall_n0.copy()
         rates = np.zeros(self.W)
-        for k, w in enumerate(self.walls):
-            p[k] = p[k] + w.velocity * self.step_no * self.dt
-            if w.rotation:
-                nrot = self.wall_rot_steps[k]
-                angle = self.wall_rate[k] * self.dt * min(self.step_no, nrot)
-                R = _rotation_matrix(w.rotation.axis, angle)
-                p[k] = w.rotation.pivot + R @ (p[k] - w.rotation.pivot)
-                n[k] = R @ n[k]
-                rates[k] = self.wall_rate[k] if 1 <= self.step_no <= nrot else 0.0
-        return p, n, rates
+        for k in self.turning_walls:
+            rot, nrot = self.walls[k].rotation, self.wall_rot_steps[k]
+            R = self.wall_turn[k].matrix(self.wall_rate[k] * self.dt * min(self.step_no, nrot))
+            p[k] = rot.pivot + R @ (p[k] - rot.pivot)
+            n[k] = R @ n[k]
+            rates[k] = self.wall_rate[k] if 1 <= self.step_no <= nrot else 0.0
+        return p, n, rates, (p * n).sum(axis=1)
 
     def _wall_velocity(self, wk, cp, rates):
         """Velocity of walls wk at contact points cp during the last step."""
-        vw = self.wall_v[wk]
-        for k in np.flatnonzero(rates):
+        vw = self.wall_v.take(wk, 0)
+        for k in rates.nonzero()[0]:
             rot = self.walls[k].rotation
             sel = wk == k
-            vw[sel] += rates[k] * _cross(np.broadcast_to(rot.axis, cp[sel].shape), cp[sel] - rot.pivot)
+            vw[sel] += rates[k] * _cross(rot.axis[None, :], cp[sel] - rot.pivot)  # (the axis row broadcasts)
         return vw
 
     def wall_angle(self, k):
@@ -156,12 +163,13 @@ class Simulation:
 
     # ------------------------------------------------------------ contact detection
     def _candidate_pairs(self):
+        """Pairs of grains that may touch: (a, b, r_a + r_b), with a < b."""
         N = self.N
         if N < 2:
-            return np.zeros((0, 2), np.int64)
+            return None
         if N <= PAIR_BRUTE_FORCE_MAX:
             if self.pairs is None:
-                self.pairs = np.array(np.triu_indices(N, 1)).T
+                self.pairs = self._pair_list(np.array(np.triu_indices(N, 1)).T)
             return self.pairs
         # Verlet list with a skin: rebuilt only when some grain has moved skin/2.
         if self.x_at_build is not None:
@@ -170,51 +178,51 @@ class Simulation:
                 return self.pairs
         from scipy.spatial import cKDTree
         tree = cKDTree(self.x[:, : self.dim])
-        self.pairs = tree.query_pairs(2 * self.r.max() + self.skin, output_type="ndarray").astype(np.int64)
+        self.pairs = self._pair_list(tree.query_pairs(2 * self.r.max() + self.skin, output_type="ndarray"))
         self.x_at_build = self.x.copy()
         return self.pairs
 
+    def _pair_list(self, pairs):
+        """(a, b, r_a + r_b) of an (M, 2) array of grain pairs."""
+        a, b = pairs[:, 0].astype(np.int64), pairs[:, 1].astype(np.int64)
+        return a, b, self.r[a] + self.r[b]
+
     def _contacts(self):
-        """All touching grain-grain and grain-wall contacts: i, j, key, n (i -> j), overlap,
-        lever arms and the velocity of j's contact point."""
+        """All touching grain-grain and grain-wall contacts: i, j, key, n (i -> j), overlap
+        and the velocity of j's contact point; the grain pairs come first (how many: the
+        last value)."""
         N, W = self.N, self.W
-        ii, jj, nn, dd, vj, rj = [], [], [], [], [], []
+        parts = []  # (i, j, n, delta, v_j) of the touching pairs, then of the walls
+        P = 0  # touching pairs
         pairs = self._candidate_pairs()
-        if len(pairs):
-            a, b = pairs[:, 0], pairs[:, 1]
-            d = self.x[b] - self.x[a]
+        if pairs is not None and len(pairs[0]):
+            a, b, reach = pairs
+            d = self.x.take(b, 0) - self.x.take(a, 0)
             dist = np.sqrt(_dot(d, d))
-            delta = self.r[a] + self.r[b] - dist
-            t = delta > 0
-            if t.any():
-                a, b, d, dist, delta = a[t], b[t], d[t], dist[t], delta[t]
-                ii.append(a)
-                jj.append(b)
-                nn.append(d / dist[:, None])
-                dd.append(delta)
-                vj.append(self.v[b])
-                rj.append(self.r[b])
+            delta = reach - dist
+            touching = delta > 0.0
+            P = np.count_nonzero(touching)
+            if P:
+                if P < len(touching):
+                    t = touching.nonzero()[0]
+                    a, b, d, dist, delta = a.take(t), b.take(t), d.take(t, 0), dist.take(t), delta.take(t)
+                parts.append((a, b, d / dist[:, None], delta, self.v.take(b, 0)))
         if W:
-            p, n, rates = self._wall_state()
-            delta = self.r[:, None] - (self.x @ n.T - np.sum(p * n, axis=1))
-            gi, wk = np.nonzero(delta > 0)
+            p, n, rates, offset = self._wall_state()
+            delta = self.r_col - (self.x @ n.T - offset)
+            gi, wk = (delta > 0.0).nonzero()
             if len(gi):
                 dw = delta[gi, wk]
-                ii.append(gi)
-                jj.append(N + wk)
-                nn.append(-n[wk])
-                dd.append(dw)
+                n_w = n.take(wk, 0)
                 vw = np.zeros((len(gi), 3))
                 if self.moving_walls:
-                    vw = self._wall_velocity(wk, self.x[gi] - (self.r[gi] - dw)[:, None] * n[wk], rates)
-                vj.append(vw)
-                rj.append(np.zeros(len(gi)))
-        if not ii:
+                    vw = self._wall_velocity(wk, self.x.take(gi, 0) - (self.r.take(gi) - dw)[:, None] * n_w, rates)
+                parts.append((gi, N + wk, -n_w, dw, vw))
+        if not parts:
             z = np.zeros(0, np.int64)
-            return z, z, z, np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3)), np.zeros(0)
-        i, j = np.concatenate(ii), np.concatenate(jj)
-        key = i * (N + W) + j
-        return i, j, key, np.concatenate(nn), np.concatenate(dd), np.concatenate(vj), np.concatenate(rj)
+            return z, z, z, np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3)), 0
+        i, j, n, delta, v_j = parts[0] if len(parts) == 1 else [np.concatenate(c) for c in zip(*parts)]
+        return i, j, i * (N + W) + j, n, delta, v_j, P
 
     # ------------------------------------------------------------ forces
     def _forces(self, elapsed=None):
@@ -222,18 +230,19 @@ class Simulation:
         time over which the springs are loaded (one step, or 0 at setup)."""
         dt = self.dt if elapsed is None else elapsed
         N = self.N
-        i, j, key, n, delta, v_j, r_j = self._contacts()
-        grain_j = j < N
+        i, j, key, n, delta, v_j, P = self._contacts()  # rows :P are grain pairs
         # Relative velocity of i's contact point with respect to j's (docs/law.md step 1).
-        v_rel = self.v[i] - v_j
+        v_rel = self.v.take(i, 0) - v_j
         if self.rotation_on:
             # Lever arms from each centre to the contact point, taken midway in the overlap
             # (c = r - delta/2, as LIGGGHTS and YADE place it; a wall has none):
             # w_i x (c_i n) + w_j x (c_j n) = (c_i w_i + c_j w_j) x n, both along n.
-            c_i = self.r[i] - 0.5 * delta
-            c_j = np.where(grain_j, r_j - 0.5 * delta, 0.0)
-            w_j = np.where(grain_j[:, None], self.w[np.minimum(j, N - 1)], 0.0)
-            v_rel = v_rel + _cross(c_i[:, None] * self.w[i] + c_j[:, None] * w_j, n)
+            grain_j = j < N
+            j_grain = np.minimum(j, N - 1)  # j, or any grain for a wall (masked out below)
+            c_i = self.r.take(i) - 0.5 * delta
+            c_j = np.where(grain_j, self.r.take(j_grain) - 0.5 * delta, 0.0)
+            w_j = np.where(grain_j[:, None], self.w.take(j_grain, 0), 0.0)
+            v_rel = v_rel + _cross(c_i[:, None] * self.w.take(i, 0) + c_j[:, None] * w_j, n)
         v_n = _dot(v_rel, n)
         V_s = v_rel - v_n[:, None] * n  # eq. 6
         fn = normal_force(delta, v_n, self.p)  # eq. 3
@@ -242,7 +251,7 @@ class Simulation:
         # ended contacts are dropped (their keys are simply not carried).
         if not self.p.has_spring:
             D = np.zeros((len(key), 3))
-        elif len(key) == len(self.keys) and np.array_equal(key, self.keys):
+        elif key.tobytes() == self.keys.tobytes():  # (np.array_equal, without its overhead)
             D = rotate_history(self.D, n)  # same contacts as last step (the usual case)
         else:
             D = np.zeros((len(key), 3))
@@ -261,23 +270,24 @@ class Simulation:
             self._account_contact_energy(fn, delta, v_n, tan, dt)
 
         self.keys, self.D = key, D
-        self.slip_steps += int(slipped.sum())
+        self.slip_steps += int(np.count_nonzero(slipped))
         self.contacts = Contacts(i, j, key, n, fn, F_s, slipped, delta)
 
         F = -fn[:, None] * n + F_s
-        jg = j[grain_j]
         # Forces on i, and the opposite on grain j (walls take nothing), in one scatter.
-        f = _scatter(np.concatenate((i, jg)), np.concatenate((F, -F[grain_j])), N)
+        on = np.concatenate((i, j[:P])) if P else i
+        f = _scatter(on, np.concatenate((F, -F[:P])) if P else F, N)
         torque = None
         if self.rotation_on:
             # Torques (c_i n) x F_s on i and (-c_j n) x (-F_s) = c_j (n x F_s) on j.
             c = _cross(n, F_s)
-            torque = _scatter(np.concatenate((i, jg)),
-                              np.concatenate((c_i[:, None] * c, c_j[grain_j][:, None] * c[grain_j])), N)
+            torque = _scatter(on, np.concatenate((c_i[:, None] * c, c_j[:P, None] * c[:P])) if P else c_i[:, None] * c,
+                              N)
         if self.gravity_on:
             if self.turning_gravity:  # the gravity of the time the positions belong to
                 self.g = self.scene.gravity_at(self.step_no * self.dt)
-            f += self.m[:, None] * self.g
+                self.weight = self.m_col * self.g
+            f += self.weight
         return f, torque
 
     def slip_statistics(self):
@@ -305,8 +315,8 @@ class Simulation:
     # ------------------------------------------------------------ integration
     def step(self):
         dt = self.dt
-        a = self.f / self.m[:, None]
-        v_half = self.v + 0.5 * dt * a
+        a = self.f / self.m_col
+        v_half = self.v + self.half_dt * a  # (0.5 * dt) * a
         if self.any_imposed:
             v_half = np.where(self.imposed, self.v_imposed, v_half)
         x_old = self.x
@@ -315,7 +325,7 @@ class Simulation:
             self.x[:, 2] = 0.0
             v_half[:, 2] = 0.0
         if self.rotation_on:
-            w_half = self.w + 0.5 * dt * self.torque / self.inertia[:, None]
+            w_half = self.w + self.half_dt * self.torque / self.inertia_col
             if self.dim == 2:
                 w_half[:, :2] = 0.0
             if self.any_fixed:
@@ -326,13 +336,13 @@ class Simulation:
             self.w = w_half
         self.step_no += 1
         self.f, self.torque = self._forces()
-        self.v = v_half + 0.5 * dt * self.f / self.m[:, None]
+        self.v = v_half + self.half_dt * self.f / self.m_col
         if self.any_imposed:
             self.v = np.where(self.imposed, self.v_imposed, self.v)
         if self.dim == 2:
             self.v[:, 2] = 0.0
         if self.rotation_on:
-            self.w = w_half + 0.5 * dt * self.torque / self.inertia[:, None]
+            self.w = w_half + self.half_dt * self.torque / self.inertia_col
             if self.dim == 2:
                 self.w[:, :2] = 0.0
             if self.any_fixed:
@@ -355,7 +365,7 @@ class Simulation:
         i, j, _, n, fn, F_s, _, delta = self.contacts
         on_wall = j >= self.N
         if on_wall.any():
-            _, _, rates = self._wall_state()
+            rates = self._wall_state()[2]
             i, n, delta = i[on_wall], n[on_wall], delta[on_wall]
             cp = self.x[i] + (self.r[i] - delta)[:, None] * n
             vw = self._wall_velocity(j[on_wall] - self.N, cp, rates)
@@ -378,7 +388,7 @@ class Simulation:
     # ------------------------------------------------------------ recording
     def _setup_recording(self):
         out = self.scene.output
-        self.rec_grains = [self.names[g] for g in out.grains]
+        self.rec_grains = np.array([self.names[g] for g in out.grains], np.int64)
         NW = self.N + self.W
         pairs = [(self.names[a], self.names[b]) for a, b in out.contacts]
         # A contact a-b is stored with i < j for grain pairs; remember the sign.
@@ -393,7 +403,7 @@ class Simulation:
         if not len(self.rec_keys):
             return
         key, slipped = self.contacts.key, self.contacts.slipped
-        if not slipped.any():
+        if not np.count_nonzero(slipped):
             return
         order = np.argsort(key)
         pos = np.minimum(np.searchsorted(key[order], self.rec_keys), len(key) - 1)
@@ -414,8 +424,8 @@ class Simulation:
                     fn[r], ft[r] = c.fn[idx], c.force[idx, :d] * self.rec_sign[r]
         spin = None
         if self.rotation_on:
-            spin = self.w[g][:, 2:] if d == 2 else self.w[g]
-        row = (self.step_no * self.dt, self.x[g, :d].copy(), self.v[g, :d].copy(), spin, fn, ft,
+            spin = self.w.take(g, 0)[:, 2:] if d == 2 else self.w.take(g, 0)
+        row = (self.step_no * self.dt, self.x.take(g, 0)[:, :d], self.v.take(g, 0)[:, :d], spin, fn, ft,
                self.rec_slips.copy(), [self.wall_angle(k) for k in self.rec_walls])
         self.rec_slips[:] = 0
         stats = (len(self.contacts.key), self.kinetic_energy()) if self.scene.output.stats else None
@@ -462,7 +472,7 @@ class Simulation:
                     self.record_row()
             if progress is not None and k % 2000 == 0:
                 progress(k, steps)
-            if not (np.isfinite(self.x).all() and np.isfinite(self.v).all()):
+            if not (_all_finite(self.x) and _all_finite(self.v)):
                 raise FloatingPointError(f"non-finite position or velocity at step {self.step_no} "
                                          f"(t = {self.step_no * self.dt:g} s)")
         if progress is not None:
@@ -470,22 +480,45 @@ class Simulation:
         return self.recording(steps, time.perf_counter() - t0)
 
 
+# Component k of a x b is a[k+1] b[k+2] - a[k+2] b[k+1] (indices mod 3).
+_NEXT, _AFTER_NEXT = np.array([1, 2, 0]), np.array([2, 0, 1])
+
+
 def _cross(a, b):
-    """Row-wise cross product of (K, 3) arrays (np.cross, without its axis juggling)."""
-    return np.stack((a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
-                     a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-                     a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]), axis=1)
+    """Row-wise cross product of (K, 3) arrays (np.cross, without its axis juggling);
+    `a` may be a single row, broadcast over b's."""
+    return a.take(_NEXT, 1) * b.take(_AFTER_NEXT, 1) - a.take(_AFTER_NEXT, 1) * b.take(_NEXT, 1)
+
+
+def _all_finite(a):
+    """np.isfinite(a).all(), faster on a few grains."""
+    return np.count_nonzero(np.isfinite(a)) == a.size
 
 
 def _scatter(idx, values, n):
-    """Sum the rows of `values` (K, 3) into n rows by index (np.add.at, but faster)."""
+    """Sum the rows of `values` (K, 3) into n rows by index, in the rows' order from zero
+    (np.add.at; np.bincount, which adds in the same order, is faster for many rows)."""
+    if len(idx) <= SCATTER_ADD_AT_MAX:
+        out = np.zeros((n, 3))
+        np.add.at(out, idx, values)
+        return out
     flat = (idx[:, None] * 3 + np.arange(3)).ravel()
-    # (with no contacts bincount returns integers: keep the sum in floating point)
-    return np.bincount(flat, values.ravel(), 3 * n).reshape(n, 3).astype(float, copy=False)
+    return np.bincount(flat, values.ravel(), 3 * n).reshape(n, 3)
 
 
-def _rotation_matrix(axis, angle):
-    """Rodrigues' formula: rotation by `angle` about unit `axis`."""
-    k = np.asarray(axis, float)
-    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
+class _Rotation:
+    """Rotations about one fixed unit axis, by Rodrigues' formula; the last matrix is
+    kept (a wall that has stopped turning asks for the same angle every step)."""
+
+    def __init__(self, axis):
+        k = np.asarray(axis, float)
+        self.K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+        self.I = np.eye(3)
+        self.angle, self.R = None, None
+
+    def matrix(self, angle):
+        """R = I + sin(angle) K + (1 - cos(angle)) K K (Rodrigues' formula)."""
+        if angle != self.angle:
+            K = self.K
+            self.angle, self.R = angle, self.I + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
+        return self.R

@@ -16,7 +16,7 @@ import numpy as np
 from pyref import Simulation
 from pyref.laws import every_step_slips_speed
 
-from . import parallel, plotstyle
+from . import parallel, plotstyle, runner
 from . import scene as scene_mod
 
 SPEEDS = np.logspace(-6, -2, 17)  # m/s: 4 decades, past the dashpot threshold (~1e-3 m/s)
@@ -25,17 +25,23 @@ PERIODS = 6  # saw-tooth periods averaged after the first slip (at least MIN_STE
 MIN_STEPS = 400
 
 
+def steps_needed(sc, speed, dt):
+    """Steps of a drag at `speed`: the static phase, PERIODS + 1 saw-tooth periods, and
+    MIN_STEPS more."""
+    p = sc.contact
+    fn = sc.grain_mass(sc.grains[0]) * float(np.linalg.norm(sc.gravity))
+    period = 2 * (p.mu_s - p.mu_k) * fn / (p.ks * speed)
+    static = p.mu_s * fn / (p.ks * speed)
+    return int((static + (PERIODS + 1) * period) / dt) + MIN_STEPS
+
+
 def mean_friction(base, speed, dt, timing):
     """Mean |Fs|/Fn of a drag at `speed` over whole saw-tooth periods after the first slip
     (over MIN_STEPS steps where every step slips)."""
     sc = scene_mod.load(base, dt=dt, slip_timing=timing)
     sc.grains[0].velocity = np.array([speed, 0.0, 0.0])
     sim = Simulation(sc, record=False)
-    p = sc.contact
-    fn = sc.grain_mass(sc.grains[0]) * float(np.linalg.norm(sc.gravity))
-    period = 2 * (p.mu_s - p.mu_k) * fn / (p.ks * speed)
-    static = p.mu_s * fn / (p.ks * speed)
-    steps = int((static + (PERIODS + 1) * period) / dt) + MIN_STEPS
+    steps = steps_needed(sc, speed, dt)
     ratio, slipped = np.zeros(steps), np.zeros(steps, bool)
     for k in range(steps):
         sim.step()
@@ -59,7 +65,8 @@ def plan(out: Path, scene="drag", speeds=SPEEDS, dt_factors=DT_FACTORS):
     CSV and the figure from their results."""
     base = scene_mod.load(scene)
     keys = [(timing, base.dt * f, float(v)) for timing in ("step", "exact") for f in dt_factors for v in speeds]
-    tasks = [(1.0 / (dt * v), mean_friction, (scene, v, dt, timing)) for timing, dt, v in keys]
+    tasks = [(runner.cost(base, "pyref", steps_needed(base, v, dt)), mean_friction, (scene, v, dt, timing))
+             for timing, dt, v in keys]
 
     def finish(results):
         rows = []

@@ -1,6 +1,7 @@
 """Independent runs on every core, with one progress bar.
 
-A task is (cost, function, args): a module-level function and picklable arguments.
+A task is (cost, function, args): a module-level function and picklable arguments;
+cost is the task's estimated seconds (runner.cost), the same unit for every kind of task.
 `run_all` runs the costliest first (so the last ones to finish are short), on
 `workers()` processes, and returns the results in the tasks' order. A task that raises
 returns its exception instead, so one failing engine does not lose the others' runs.
@@ -8,6 +9,7 @@ returns its exception instead, so one failing engine does not lose the others' r
 from __future__ import annotations
 
 import os
+import resource
 import sys
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -22,34 +24,48 @@ def workers() -> int:
         return n
 
 
+def _cpu_seconds():
+    """CPU time of this process and of the processes it waited for (engines it started)."""
+    me, engines = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + engines.ru_utime + engines.ru_stime
+
+
 def _call(fn, args):
+    """fn(*args) and the CPU seconds it took."""
+    start = _cpu_seconds()
     try:
-        return fn(*args)
+        result = fn(*args)
     except Exception as e:  # returned, not raised: the caller decides what a failure means
-        return e
+        result = e
+    return result, _cpu_seconds() - start
 
 
-def run_all(tasks, label="runs", progress=True, n_workers=None):
-    """n_workers: processes (default: workers())."""
+def run_all(tasks, label="runs", progress=True, cpu_log=None, n_workers=None):
+    """The tasks' results in their order. cpu_log: a list to which (task, CPU seconds) is
+    appended for every task (what `stickslip bench --report` reports). n_workers: processes
+    (default: workers())."""
     n_workers = n_workers or workers()
     order = sorted(range(len(tasks)), key=lambda k: -tasks[k][0])
     results = [None] * len(tasks)
+    cpu = [0.0] * len(tasks)
     bar = _Bar(label, len(tasks), progress)
     if n_workers == 1 or len(tasks) == 1:
         for k in order:
-            results[k] = _call(*tasks[k][1:])
+            results[k], cpu[k] = _call(*tasks[k][1:])
             bar.done()
-        bar.close()
-        return results
-    with ProcessPoolExecutor(max_workers=n_workers) as pool:
-        pending = {pool.submit(_call, *tasks[k][1:]): k for k in order}
-        while pending:
-            finished, _ = wait(pending, timeout=1.0, return_when=FIRST_COMPLETED)
-            for f in finished:
-                results[pending.pop(f)] = f.result()
-                bar.done()
-            bar.tick()
+    else:
+        with ProcessPoolExecutor(max_workers=n_workers) as pool:
+            pending = {pool.submit(_call, *tasks[k][1:]): k for k in order}
+            while pending:
+                finished, _ = wait(pending, timeout=1.0, return_when=FIRST_COMPLETED)
+                for f in finished:
+                    k = pending.pop(f)
+                    results[k], cpu[k] = f.result()
+                    bar.done()
+                bar.tick()
     bar.close()
+    if cpu_log is not None:
+        cpu_log += zip(tasks, cpu)
     return results
 
 

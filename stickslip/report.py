@@ -18,9 +18,10 @@ from .studies import plan as study_plan
 CASES = ("drag", "tray", "tilt")  # the paper's three examples (section 3), in cases/
 
 
-def build_report(out: Path, engines=None, progress=True, studies=True):
+def build_report(out: Path, engines=None, progress=True, studies=True, cpu_log=None):
     """Every run of the report (cases and studies) goes to parallel.run_all at once, so
-    both cores stay busy; the costliest runs start first."""
+    both cores stay busy; the costliest runs start first; a run the cases and a study both
+    ask for runs once. cpu_log: see parallel.run_all."""
     out = Path(out)
     ok, missing = adapters.available()
     engines = [e for e in (engines or ok) if e in ok]
@@ -40,7 +41,8 @@ def build_report(out: Path, engines=None, progress=True, studies=True):
                     tasks.append(runner.task(case, eng, out / "runs" / _label(case, law, timing, base) / eng,
                                              law=law, slip_timing=timing))
     study_tasks, finish_studies = study_plan(out, CASES, engines) if studies else ([], None)
-    got = parallel.run_all(tasks + study_tasks, "report", progress)
+    unique, results_of = runner.once(tasks + study_tasks)
+    got = results_of(parallel.run_all(unique, "report", progress, cpu_log))
     results = {case: {} for case in CASES}  # case -> {(law, timing, engine): (scene, summary, df)}
     for (case, law, timing, eng), r in zip(keys, got):
         if isinstance(r, Exception):  # an engine failing must not lose the others' results

@@ -5,8 +5,10 @@ scene (checked) -> adapter.run -> time series (stickslip/columns.py), checked fi
 """
 from __future__ import annotations
 
+import copy
 import json
 import math
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -111,13 +113,19 @@ def _one_line(e):
     return text or type(e).__name__
 
 
-# Rough seconds per grain-step, only to run the longest jobs first (stickslip/parallel.py).
-_SPEED = {"pyref": 4e-5, "liggghts": 3e-6, "yade": 1e-4}
-_START = {"pyref": 0.0, "liggghts": 0.5, "yade": 1.5}  # process start-up, s
+# Rough seconds per step (a part per step and one per grain or wall) and to start an
+# engine, only to run the longest jobs first (stickslip/parallel.py). On the paper's
+# small scenes a step costs about the same whatever the grains (pyref: numpy's per-call
+# overhead; YADE: its Python law), so the part per step dominates there.
+_STEP = {"pyref": 5e-5, "liggghts": 2e-6, "yade": 2.5e-4}
+_PER_OBJECT = {"pyref": 1e-6, "liggghts": 3e-7, "yade": 5e-6}
+_START = {"pyref": 0.0, "liggghts": 0.5, "yade": 1.5}
 
 
-def cost(scene, engine) -> float:
-    return scene.steps * (len(scene.grains) + len(scene.walls)) * _SPEED[engine] + _START[engine]
+def cost(scene, engine, steps=None) -> float:
+    """Estimated seconds of a run of `scene` (or of `steps` steps of it) on `engine`."""
+    steps = scene.steps if steps is None else steps
+    return _START[engine] + steps * (_STEP[engine] + _PER_OBJECT[engine] * (len(scene.grains) + len(scene.walls)))
 
 
 def run_named(scene_name, engine, out_dir, overrides):
@@ -130,3 +138,30 @@ def run_named(scene_name, engine, out_dir, overrides):
 def task(scene_name, engine, out_dir, **overrides):
     """(cost, function, args) of one run, for parallel.run_all."""
     return (cost(scene_load(scene_name, **overrides), engine), run_named, (scene_name, engine, out_dir, overrides))
+
+
+def once(tasks):
+    """Tasks for parallel.run_all with every run that is asked for more than once (the
+    report's case at the scene's dt is also a step of its precision ladder) kept once,
+    and the function that turns their results into one per task of `tasks`, copying a
+    repeated run's files into each of its folders."""
+    first, keep, same = {}, [], []  # same[k]: index in keep of the run task k gets
+    for t in tasks:
+        _, fn, args = t
+        key = (args[1], scene_mod.identity(args[0], **args[3])) if fn is run_named else object()
+        if key not in first:
+            first[key] = len(keep)
+            keep.append(t)
+        same.append(first[key])
+
+    def results(got):
+        out = []
+        for t, k in zip(tasks, same):
+            r, (_, fn, args) = got[k], keep[k]
+            if t is not keep[k] and not isinstance(r, Exception):
+                shutil.copytree(args[2], t[2][2], dirs_exist_ok=True)
+                r = (r[0], copy.deepcopy(r[1]), r[2].copy())
+            out.append(r)
+        return out
+
+    return keep, results

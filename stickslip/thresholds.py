@@ -18,7 +18,7 @@ import numpy as np
 
 from pyref.laws import every_step_slips_speed
 
-from . import parallel, plotstyle
+from . import parallel, plotstyle, runner
 from . import scene as scene_mod
 
 DTS = (1e-6, 4e-6, 1.6e-5)
@@ -81,7 +81,8 @@ def plan(out: Path, dts=DTS, nus=NU_S):
     """Tasks for parallel.run_all (one bisection each) and the function that writes the
     CSV and the figure from their results."""
     keys = [(nu, dt) for nu in nus for dt in dts]
-    tasks = [(1.0 / dt, _measure_drag, (dt, nu)) for nu, dt in keys]
+    drag = scene_mod.load("drag")
+    tasks = [(runner.cost(drag, "pyref", _steps(drag, dt, nu)), _measure_drag, (dt, nu)) for nu, dt in keys]
 
     def finish(results):
         rows = []
@@ -101,6 +102,15 @@ def plan(out: Path, dts=DTS, nus=NU_S):
         return rows
 
     return tasks, finish
+
+
+def _steps(base, dt, nu_s, tries=14):
+    """About how many steps `measure` takes: `tries` drags (a bisection over a factor 16 to
+    rel_tol = 1e-3 takes 12, and two to check its ends), each through its static phase at
+    about V* and `after_first` steps more."""
+    p = base.contact
+    static_steps = p.mu_s * (p.ks * dt + nu_s) / (2 * (p.mu_s - p.mu_k) * p.ks * dt)
+    return tries * int(static_steps + 45)
 
 
 def _measure_drag(dt, nu_s):

@@ -10,7 +10,7 @@ from pyref.laws import LAWS, RESETS, SLIP_TIMINGS
 
 from ..errors import SceneError
 from .model import Contact, Grain, Output, Scene, Wall, WallRotation
-from .reader import CASES_DIR, EFFECTS, MAX_START_OVERLAP, check_contact, find, load, parse
+from .reader import CASES_DIR, EFFECTS, MAX_START_OVERLAP, check_contact, find, identity, load, parse
 from .stability import (
                         CONTACT_STEPS,
                         IMPACT_STEPS,
@@ -25,4 +25,4 @@ from .stability import (
 __all__ = ["CASES_DIR", "CONTACT_STEPS", "EFFECTS", "IMPACT_STEPS", "LAWS", "MAX_START_OVERLAP", "RESETS",
            "RESTITUTION_ERROR", "SLIP_TIMINGS", "Contact", "Grain", "Output", "Scene", "SceneError", "Wall",
            "WallRotation", "accuracy_warnings", "check_contact", "contact_steps", "contact_time", "critical_dt",
-           "find", "load", "parse", "stability_limits"]
+           "find", "identity", "load", "parse", "stability_limits"]

@@ -6,6 +6,7 @@ read, so they are checked by the same rules and named the same way.
 """
 from __future__ import annotations
 
+import json
 import math
 import re
 import tomllib
@@ -107,6 +108,15 @@ def load(name_or_path, **overrides) -> Scene:
     except RecursionError:
         raise SceneError(f"{path}: not a scene file (arrays or tables nested too deeply)") from None
     return parse(data, source=path, overrides=overrides)
+
+
+def identity(name_or_path, **overrides) -> str:
+    """The scene file's data with the overrides written in, as canonical text: two runs of
+    equal identity on one engine are the same run (a precision ladder's step at the
+    scene's own dt is the case's run)."""
+    path = find(name_or_path)
+    data = _apply_overrides(tomllib.loads(path.read_text()), overrides)
+    return json.dumps(data, sort_keys=True, default=str)
 
 
 def parse(data: dict, source=None, overrides=None) -> Scene:
