@@ -114,7 +114,7 @@ def _plot_divergence(out, table, fits):
                         label=f"{_name(c)} (e-folds every {tau * 1e3:.1f} ms)")
     ax.axhspan(*FIT_RANGE, color="0.93", label="range of the fit")
     ax.set_xlabel("t (s)")
-    ax.set_ylabel("largest distance between a grain's two positions (m)")
+    ax.set_ylabel("largest distance between\na grain's two positions (m)")
     ax.legend(fontsize=7)
     return save(fig, out, "engines_divergence.png")
 

@@ -292,13 +292,22 @@ def _table(study, figs):
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "drum"
 
 
+def _markdown_table(df):
+    def cell(v):
+        return f"{v:.4g}" if isinstance(v, float) else str(v)
+    return "\n".join(["| " + " | ".join(df.columns) + " |", "|" + "---|" * len(df.columns)]
+                     + ["| " + " | ".join(cell(v) for v in row) + " |" for row in df.itertuples(index=False)])
+
+
 def report_section(report_dir, docs=DOCS):
-    """The report's drum section: the finished study's table and figures (the report does
-    not run the study: it takes ~45 min), or how to run it."""
+    """The report's drum section: the finished study's table and figures, and the engines'
+    comparison when `stickslip drum-engines` has written it (the report runs neither: they
+    take most of an hour), or how to run them."""
     lines = ["", "## Granular scale: avalanches in a turning drum", ""]
     if not (docs / "study.csv").is_file():
-        return "\n".join(lines + ["No finished drum study is present. Run it (LIGGGHTS with MPI, ~45 min on 2 "
-                                  "cores, resumable): `.venv/bin/stickslip drum-study`; it writes docs/drum/.", ""])
+        return "\n".join(lines + ["No finished drum study is present. Run it (LIGGGHTS on both cores, under an hour, "
+                                  "resumable): `.venv/bin/stickslip drum-study`; it writes docs/drum/ (the findings: "
+                                  "docs/drum.md).", ""])
     rel = os.path.relpath(docs, report_dir)
     study = pd.read_csv(docs / "study.csv")
     lines += [f"From the finished study in [{rel}/study.md]({rel}/study.md) ({len(study)} runs; the findings and the "
@@ -312,4 +321,16 @@ def report_section(report_dir, docs=DOCS):
     lines.append("")
     for png in sorted(docs.glob("drum_*.png")):
         lines += [f"![{png.stem}]({rel}/{png.name})", ""]
+    lines += ["### The drum across engines", ""]
+    if (docs / "engines_divergence.png").is_file():
+        lines += ["How far each engine's grains are from pyref's over the drum's first 0.4 s (round-off grown by the "
+                  f"pile's chaos; [{rel}/engines_divergence.csv]({rel}/engines_divergence.csv)):", "",
+                  f"![engines_divergence]({rel}/engines_divergence.png)", ""]
+    for name, what in (("engines.csv", "avalanche statistics of the same drum on LIGGGHTS and YADE"),
+                       ("costs.csv", "each engine's cost on the drum")):
+        if (docs / name).is_file():
+            lines += [f"{what[0].upper() + what[1:]}: [{rel}/{name}]({rel}/{name}).", "",
+                      _markdown_table(pd.read_csv(docs / name)), ""]
+    if lines[-2] == "### The drum across engines":
+        lines += ["Not measured yet: `.venv/bin/stickslip drum-engines` writes it.", ""]
     return "\n".join(lines)
