@@ -66,7 +66,9 @@ case "${1:-}" in
     test)
         setup
         shift
-        .venv/bin/python -m pytest -q "$@"
+        # both cores (pytest-xdist; STICKSLIP_TEST_JOBS=0 runs them in this process): tests are
+        # independent, and the runs several tests read are made once (tests/conftest.py)
+        .venv/bin/python -m pytest -q -n "${STICKSLIP_TEST_JOBS:-auto}" --dist worksteal "$@"
         ;;
     setup)
         setup

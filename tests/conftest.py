@@ -1,7 +1,10 @@
-import functools
+import fcntl
+import hashlib
+import os
 import sys
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -33,19 +36,40 @@ def run_pyref(sc, energy=False):
     return columns.frame(sc, sim.run()), sim
 
 
-def paper_case(name, law=None, duration=None):
-    """The paper's cases are run once per test session and shared by the tests."""
-    # one cache key however the caller spells it (lru_cache keys keywords and positions apart)
-    return _paper_case(name, law, duration)
+SHARED = None  # the session's folder of shared pyref runs (set by shared_runs_folder)
+_loaded = {}   # this process's copies of them
 
 
-@functools.lru_cache(maxsize=None)
-def _paper_case(name, law, duration):
-    kw = {}
-    if law:
-        kw["law"] = law
-    if duration:
-        kw["duration"] = duration
-    sc = scene_mod.load(name, **kw)
-    df, sim = run_pyref(sc)
-    return sc, df, sim
+@pytest.fixture(scope="session", autouse=True)
+def shared_runs_folder(tmp_path_factory):
+    """One folder per test session for the runs paper_case shares. With pytest-xdist each
+    worker's temporary folder is a subfolder of the session's, so the workers share its
+    parent; without xdist the session's own folder is used."""
+    global SHARED
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent
+    SHARED = base / "shared-pyref-runs"
+    SHARED.mkdir(exist_ok=True)
+
+
+def paper_case(name, **overrides):
+    """pyref's run of a case (a name and scene.load's overrides: duration, law, slip_timing,
+    ...), made once per test session and shared by every test that reads it, in every
+    xdist worker: the first to ask runs it while holding a file lock, the others wait for
+    it and read its time series. Returns (scene, time series). Runs are told apart by the
+    scene's data with the overrides written in (scene.identity): a value the file already
+    has is spelt by leaving the override out, as every caller does."""
+    sc = scene_mod.load(name, **overrides)
+    key = hashlib.sha256(scene_mod.identity(name, **overrides).encode()).hexdigest()[:24]
+    if key not in _loaded:
+        path = SHARED / f"{name}-{key}.pkl"
+        with open(SHARED / f"{name}-{key}.lock", "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file is closed
+            if not path.exists():
+                df, _ = run_pyref(sc)
+                part = path.with_suffix(".part")
+                df.to_pickle(part)
+                part.rename(path)
+            _loaded[key] = pd.read_pickle(path)
+    return sc, _loaded[key]

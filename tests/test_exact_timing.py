@@ -10,7 +10,7 @@ from pyref import Simulation, laws
 from pyref.laws import LawParams, tangential_force
 from stickslip import analysis, columns
 from stickslip import scene as scene_mod
-from conftest import paper_case, run_pyref
+from conftest import paper_case
 from test_pyref_3d import TURNTABLE
 
 
@@ -163,10 +163,8 @@ def test_drag_and_tray_agree_in_both_modes_within_half_a_percent():
     for case, kw, keys in (("drag", {}, ("fs_fn_max", "fs_fn_min", "fs_fn_mean", "slip_period_s")),
                            ("tray_wedge", {"duration": 0.5}, ("y1_final_m", "time_to_rest_s")),
                            ("tray", {"duration": 0.5}, ("y1_final_m",))):
-        sc, df, _ = paper_case(case, **kw)
-        step = analysis.summarise(sc, df)
-        sc_exact = scene_mod.load(case, slip_timing="exact", **kw)
-        exact = analysis.summarise(sc_exact, run_pyref(sc_exact)[0])
+        step = analysis.summarise(*paper_case(case, **kw))
+        exact = analysis.summarise(*paper_case(case, slip_timing="exact", **kw))
         for k in keys:
             assert exact[k] == pytest.approx(step[k], rel=0.005), (case, k)
 
@@ -176,12 +174,13 @@ def test_tilt_exact_mode_is_within_one_percent_of_converged_at_the_scenes_dt():
     at dt/2: the exact mode converges with order >= 1 (docs/precision.md measures ~2), so
     the error at dt is at most 2x the difference of the two runs; it must be under 1 %
     of the final speed. The step mode, for contrast, is > 5 % off at the same step."""
-    sc, df, _ = paper_case("tilt")  # the step timing at the scene's dt, shared with other tests
-    runs = {("step", sc.dt): (sc, df)}
-    for timing, dt in (("exact", 8e-6), ("exact", 4e-6)):
-        sc = scene_mod.load("tilt", dt=dt, slip_timing=timing)
-        runs[(timing, dt)] = (sc, columns.frame(sc, Simulation(sc).run()))
     from stickslip.kinds import tilt
+
+    # both timings at the scene's dt (8e-6 s), shared with other tests
+    runs = {("step", 8e-6): paper_case("tilt"), ("exact", 8e-6): paper_case("tilt", slip_timing="exact")}
+    assert runs[("step", 8e-6)][0].dt == 8e-6
+    sc = scene_mod.load("tilt", dt=4e-6, slip_timing="exact")
+    runs[("exact", 4e-6)] = (sc, columns.frame(sc, Simulation(sc).run()))
 
     sc, ref = runs[("exact", 4e-6)]
     ref_summary = tilt.summarise(sc, ref)

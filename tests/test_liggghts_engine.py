@@ -61,7 +61,7 @@ def assert_series_agree(sc, dl, dp):
 @needs_liggghts
 def test_drag_matches_pyref(tmp_path):
     sc, dl = run_liggghts("drag", tmp_path)
-    _, dp, _ = paper_case("drag")
+    _, dp = paper_case("drag")
     sl, sp = analysis.summarise(sc, dl), analysis.summarise(sc, dp)
     for k in ("fs_fn_max", "fs_fn_min", "fs_fn_mean", "slip_period_s"):
         assert sl[k] == pytest.approx(sp[k], rel=0.01), k
@@ -73,7 +73,7 @@ def test_drag_matches_pyref(tmp_path):
 def test_tilt_matches_pyref(tmp_path):
     """The turning plate is a mesh wall moved by fix move/mesh rotate/variable."""
     sc, dl = run_liggghts("tilt", tmp_path)
-    _, dp, _ = paper_case("tilt")
+    _, dp = paper_case("tilt")
     sl, sp = analysis.summarise(sc, dl), analysis.summarise(sc, dp)
     for k in ("tan_beta_first_slip", "accel_stick_slip_mps2", "accel_steady_mps2"):
         assert sl[k] == pytest.approx(sp[k], rel=0.01), k
@@ -92,7 +92,7 @@ def test_tilt_matches_pyref(tmp_path):
 @needs_liggghts
 def test_tray_matches_pyref(tmp_path):
     sc, dl = run_liggghts("tray", tmp_path, duration=0.5)
-    _, dp, _ = paper_case("tray", duration=0.5)
+    _, dp = paper_case("tray", duration=0.5)
     sl, sp = analysis.summarise(sc, dl), analysis.summarise(sc, dp)
     assert not sl["reached_bottom"]
     r = sc.grains[0].radius
@@ -170,7 +170,7 @@ def test_drag_exact_timing_matches_pyref(tmp_path):
     overlap, so the slips' phases start from the same numbers)."""
     sc, dl = run_liggghts("drag", tmp_path, slip_timing="exact")
     assert "exact_slip_timing on" in (tmp_path / "liggghts" / "in.scene").read_text()
-    dp, _ = run_pyref(sc)
+    _, dp = paper_case("drag", slip_timing="exact")
     sl, sp = analysis.summarise(sc, dl), analysis.summarise(sc, dp)
     for k in ("fs_fn_max", "fs_fn_min", "fs_fn_mean", "slip_period_s"):
         assert sl[k] == pytest.approx(sp[k], rel=0.01), k
@@ -189,7 +189,7 @@ def test_tilt_exact_timing_matches_pyref(tmp_path):
     bound integrates to, x = sum v dt: duration * (velocity bound), on top of their own
     round-off."""
     sc, dl = run_liggghts("tilt", tmp_path, slip_timing="exact")
-    dp, _ = run_pyref(sc)
+    _, dp = paper_case("tilt", slip_timing="exact")
     sl, sp = analysis.summarise(sc, dl), analysis.summarise(sc, dp)
     for k in ("tan_beta_first_slip", "accel_stick_slip_mps2", "accel_steady_mps2"):
         assert sl[k] == pytest.approx(sp[k], rel=0.01), k

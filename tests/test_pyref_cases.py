@@ -10,7 +10,7 @@ from conftest import paper_case
 
 # ---------------------------------------------------------------- drag (Fig. 9)
 def test_drag_saw_tooth_bounds_mean_and_period():
-    sc, df, _ = paper_case("drag")
+    sc, df = paper_case("drag")
     s = analysis.summarise(sc, df)
     p = sc.contact
     # The recorded peak is the last stick step's force, which is below mu_s*Fn by at
@@ -33,7 +33,7 @@ def test_drag_saw_tooth_bounds_mean_and_period():
 
 
 def test_drag_static_phase_is_linear_until_mu_s():
-    sc, df, _ = paper_case("drag")
+    sc, df = paper_case("drag")
     c = "grain-floor"
     first = np.nonzero(df[f"{c}_slip"].to_numpy())[0][0]
     fs = df[f"{c}_fs"].to_numpy()[1:first]
@@ -45,7 +45,7 @@ def test_drag_static_phase_is_linear_until_mu_s():
 
 # ---------------------------------------------------------------- tray (Fig. 11)
 def test_tray_stick_slip_holds_grain_1():
-    sc, df, _ = paper_case("tray", duration=0.5)
+    sc, df = paper_case("tray", duration=0.5)
     s = analysis.summarise(sc, df)
     assert not s["reached_bottom"]
     # Held where it first wedged: above the bottom by more than half its fall room, the
@@ -65,7 +65,7 @@ def test_tray_stick_slip_holds_grain_1():
 # within the scene's 2.5 s, as the paper's Fig. 11 shows.
 @pytest.mark.parametrize("case,law", [("tray_wedge", "coulomb"), ("tray", "visco_plastic")])
 def test_tray_coulomb_and_visco_plastic_reach_the_bottom(case, law):
-    sc, df, _ = paper_case(case, law=law)
+    sc, df = paper_case(case, law=law)
     s = analysis.summarise(sc, df)
     assert s["reached_bottom"], s
     if case == "tray":  # the calibration: the paper's 2.65 s within 5 %
@@ -74,7 +74,7 @@ def test_tray_coulomb_and_visco_plastic_reach_the_bottom(case, law):
 
 def test_tray_coulomb_force_alternates_sign():
     # Fig. 12a: with Coulomb friction the tangential force flips between +-mu*Fn.
-    sc, df, _ = paper_case("tray_wedge", law="coulomb")
+    sc, df = paper_case("tray_wedge", law="coulomb")
     c = "grain1-grain2"
     touching = df[f"{c}_fn"] > 0
     fty = df.loc[touching, f"{c}_fty"].to_numpy()
@@ -88,7 +88,7 @@ def test_tray_coulomb_force_alternates_sign():
 
 # ---------------------------------------------------------------- tilt (Figs. 14-15)
 def test_tilt_no_slip_before_mu_s_then_first_slip_at_mu_s():
-    sc, df, _ = paper_case("tilt")
+    sc, df = paper_case("tilt")
     c = "grain-plate"
     tan_b = np.tan(df["plate_angle"].to_numpy())
     assert df[f"{c}_slip"][tan_b < sc.contact.mu_s].sum() == 0
@@ -102,7 +102,7 @@ def test_tilt_no_slip_before_mu_s_then_first_slip_at_mu_s():
 
 
 def test_tilt_stick_slip_then_steady_sliding():
-    sc, df, _ = paper_case("tilt")
+    sc, df = paper_case("tilt")
     s = analysis.summarise(sc, df)
     assert s["t_first_slip_s"] < s["t_steady_s"]
     # Stick-slip: mean friction between Fmin and mu_k*Fn, so the acceleration lies

@@ -1,5 +1,4 @@
 """The YADE law against pyref on the paper's cases (issue 4), and its parameter errors."""
-import functools
 import math
 import shutil
 import subprocess
@@ -69,15 +68,8 @@ def run_yade(name, tmp_path, **kw):
 
 
 def pyref_case(name, slip_timing):
-    """pyref's run of a paper case (shared with the other tests in the step mode)."""
-    if slip_timing == "step":
-        return paper_case(name)[1]
-    return _pyref_exact(name)
-
-
-@functools.lru_cache(maxsize=None)
-def _pyref_exact(name):
-    return run_pyref(scene_mod.load(name, slip_timing="exact"))[0]
+    """pyref's run of a paper case (shared with the other tests that read it)."""
+    return (paper_case(name) if slip_timing == "step" else paper_case(name, slip_timing=slip_timing))[1]
 
 
 U = np.finfo(float).eps / 2  # unit round-off, 1.1e-16
@@ -155,7 +147,7 @@ def test_tray_is_pyrefs_twin(tmp_path):
     holds grain 1 up; grain 1 touches the left wall at zero overlap for its first steps,
     no contact in either engine) within round-off of pyref's, and grain 1 held up."""
     sc, dy = run_yade("tray", tmp_path, duration=0.5)
-    _, dp, _ = paper_case("tray", duration=0.5)
+    _, dp = paper_case("tray", duration=0.5)
     assert_round_off_apart(sc, dy, dp)
     assert not analysis.summarise(sc, dy)["reached_bottom"]
 
