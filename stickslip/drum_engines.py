@@ -28,7 +28,7 @@ from .drum_study import load_run, run_one
 from .kinds import drum
 from .scene import find, load
 
-COST_DURATION = 0.3  # s
+COST_DURATION = 1.0  # s: the fill falls (0.2 s) and sits as a pile of ~360 contacts
 DIVERGENCE_DURATION = 0.4  # s: round-off grows to the grains' size well before (measured)
 DIVERGENCE_EVERY = 25  # steps between records
 # the part of the divergence curve the e-folding time is fitted to: above round-off's

@@ -60,10 +60,11 @@ def matrix(rate, full=True):
 
 SMOKE_LABELS = ("history_mu0.50", "ss_0.50_0.35_step")
 
-# LIGGGHTS' speed on this scene, grain-steps per second with the dumps read back (2 ranks
-# on the 2-core machine: 2.0e9 grain-steps in 200 s a run, the engine itself 1.75e7/s;
-# 1 rank about half): only to say beforehand what a study costs.
-SPEED = {1: 5e6, 2: 1.0e7}
+# LIGGGHTS' speed on this scene, grain-steps per second of one run with its dumps read back,
+# measured on the 2-core machine: 1 rank while another run uses the other core, 3.0e9
+# grain-steps in 360 s; 2 ranks, the engine 1.72e7/s (drum-engines' costs.csv) and ~40 s of
+# reading a run. Only to say beforehand what a study costs.
+SPEED = {1: 8.3e6, 2: 1.4e7}
 # The avalanche regime: the drum turns by at most MAX_TURN_PER_AVALANCHE (rad) while an
 # avalanche runs, which lasts ~5 sqrt(D/g) (0.4-1.2 s measured in this drum, D = 88 mm).
 MAX_TURN_PER_AVALANCHE = math.radians(1.0)
@@ -173,7 +174,7 @@ def run_one(sc, data, folder, engine="liggghts", ranks=1, keep_timeseries=False,
     return True
 
 
-def run_study(scene_path, out, out_runs, rate, duration, fill=None, seed=None, labels=None, full=True, ranks=2,
+def run_study(scene_path, out, out_runs, rate, duration, fill=None, seed=None, labels=None, full=True, ranks=1,
               jobs_at_once=1, keep_timeseries=False, progress=True, tables_only=False):
     """The matrix on LIGGGHTS: `jobs_at_once` runs side by side, each on `ranks` MPI
     processes; the cost said first, a line per run started and finished, the table and
