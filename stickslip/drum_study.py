@@ -295,7 +295,9 @@ DOCS = Path(__file__).resolve().parents[1] / "docs" / "drum"
 
 def _markdown_table(df):
     def cell(v):
-        return f"{v:.4g}" if isinstance(v, float) else str(v)
+        if isinstance(v, float):
+            return "—" if not np.isfinite(v) else f"{v:.4g}"
+        return str(v)
     return "\n".join(["| " + " | ".join(df.columns) + " |", "|" + "---|" * len(df.columns)]
                      + ["| " + " | ".join(cell(v) for v in row) + " |" for row in df.itertuples(index=False)])
 
@@ -327,11 +329,17 @@ def report_section(report_dir, docs=DOCS):
         lines += ["How far each engine's grains are from pyref's over the drum's first 0.4 s (round-off grown by the "
                   f"pile's chaos; [{rel}/engines_divergence.csv]({rel}/engines_divergence.csv)):", "",
                   f"![engines_divergence]({rel}/engines_divergence.png)", ""]
+    # the engines' means (centroid angles, degrees) and z = difference / combined error
+    shown = {"engines.csv": ["engine", "duration_s", "avalanches", "theta_start_centroid_mean_deg",
+                             "theta_start_centroid_se_deg", "theta_stop_centroid_mean_deg",
+                             "theta_stop_centroid_se_deg", "theta_start_centroid_z", "theta_stop_centroid_z"],
+             "costs.csv": None}
     for name, what in (("engines.csv", "avalanche statistics of the same drum on LIGGGHTS and YADE"),
                        ("costs.csv", "each engine's cost on the drum")):
         if (docs / name).is_file():
+            table = pd.read_csv(docs / name)
             lines += [f"{what[0].upper() + what[1:]}: [{rel}/{name}]({rel}/{name}).", "",
-                      _markdown_table(pd.read_csv(docs / name)), ""]
+                      _markdown_table(table[[c for c in (shown[name] or table.columns) if c in table]]), ""]
     if lines[-2] == "### The drum across engines":
         lines += ["Not measured yet: `.venv/bin/stickslip drum-engines` writes it.", ""]
     return "\n".join(lines)
