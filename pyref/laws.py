@@ -27,6 +27,11 @@ SLIP_TIMINGS = ("step", "exact")
 SETTLED = 1e-8
 MAX_EXPLICIT_SLIPS = 100
 
+try:  # numpy's C einsum itself: np.einsum's Python layer costs as much again on a few rows
+    from numpy._core.multiarray import c_einsum as _einsum
+except ImportError:  # numpy < 2
+    _einsum = np.einsum
+
 
 @dataclass
 class LawParams:
@@ -119,12 +124,12 @@ def normal_force(delta, v_n, p: LawParams):
 def rotate_history(D, n):
     """Turn the spring elongation into the current tangent plane, keeping its length
     (the 3D form; when D already lies in the plane, as in 2D on a fixed wall, nothing moves)."""
-    dn = np.einsum("ij,ij->i", D, n)
+    dn = _einsum("ij,ij->i", D, n)
     if not _any(dn):
         return D
-    old = np.einsum("ij,ij->i", D, D)
+    old = _einsum("ij,ij->i", D, D)
     D = D - dn[:, None] * n
-    new = np.einsum("ij,ij->i", D, D)
+    new = _einsum("ij,ij->i", D, D)
     scale = np.sqrt(old / np.maximum(new, 1e-300))
     return D * np.where(new > 0, scale, 1.0)[:, None]
 
@@ -320,7 +325,7 @@ def _plastic_flow(F, u, k_rest, T):
 
 
 def _dot(a, b):
-    return np.einsum("ij,ij->i", a, b)
+    return _einsum("ij,ij->i", a, b)
 
 
 def _any(a):
