@@ -31,6 +31,22 @@ class Contacts(NamedTuple):
     delta: np.ndarray  # overlap
 
 
+class _Layout(NamedTuple):
+    """The rows of the touching contacts, kept while the same contacts touch."""
+    pairs: tuple | None  # the candidate pairs they were found among
+    sig: tuple  # bytes of the touching masks (pairs, grains x walls)
+    P: int  # touching grain pairs (the first rows)
+    t: np.ndarray | None  # their indices among the candidates; None: all touch
+    gi: np.ndarray  # grain of each wall row
+    wk: np.ndarray  # wall of each wall row
+    flat: np.ndarray  # gi * W + wk, the rows' places in the grains x walls overlaps
+    fixed_n: np.ndarray | None  # the wall rows' normals (i -> wall) when walls are fixed
+    i: np.ndarray
+    j: np.ndarray
+    key: np.ndarray
+    on: np.ndarray  # grain of each force row: i, then j of the pairs
+
+
 class Recording(NamedTuple):
     """What a run recorded, one row every `output.every` steps (and the start). Grains,
     contacts and walls in the order the scene's [output] names them; `dim` components."""
@@ -113,6 +129,7 @@ class Simulation:
         self.D = np.zeros((0, 3))
         self.pairs = None  # candidate pairs: (a, b, r_a + r_b), a < b
         self.x_at_build = None
+        self._layout = None  # rows of the touching contacts (_make_layout)
         self.skin = 0.2 * float(self.r.min())
 
         # energy books: when the scene records them, or when asked (tests)
@@ -188,41 +205,78 @@ class Simulation:
         return a, b, self.r[a] + self.r[b]
 
     def _contacts(self):
-        """All touching grain-grain and grain-wall contacts: i, j, key, n (i -> j), overlap
-        and the velocity of j's contact point; the grain pairs come first (how many: the
-        last value)."""
-        N, W = self.N, self.W
-        parts = []  # (i, j, n, delta, v_j) of the touching pairs, then of the walls
-        P = 0  # touching pairs
+        """All touching grain-grain and grain-wall contacts: i, j, key, n (i -> j), overlap,
+        the velocity of the walls' contact points (None when the walls are fixed: zero)
+        and how many of the rows, the first ones, are grain pairs."""
+        x = self.x
         pairs = self._candidate_pairs()
+        pair_hit = wall_hit = None
         if pairs is not None and len(pairs[0]):
             a, b, reach = pairs
-            d = self.x.take(b, 0) - self.x.take(a, 0)
+            d = x.take(b, 0) - x.take(a, 0)
             dist = np.sqrt(_dot(d, d))
-            delta = reach - dist
-            touching = delta > 0.0
-            P = np.count_nonzero(touching)
-            if P:
-                if P < len(touching):
-                    t = touching.nonzero()[0]
-                    a, b, d, dist, delta = a.take(t), b.take(t), d.take(t, 0), dist.take(t), delta.take(t)
-                parts.append((a, b, d / dist[:, None], delta, self.v.take(b, 0)))
-        if W:
+            delta_p = reach - dist
+            pair_hit = delta_p > 0.0
+        if self.W:
             p, n, rates, offset = self._wall_state()
-            delta = self.r_col - (self.x @ n.T - offset)
-            gi, wk = (delta > 0.0).nonzero()
+            delta_w = self.r_col - (x @ n.T - offset)
+            wall_hit = delta_w > 0.0
+        # Which contacts touch rarely changes from one step to the next: the rows' indices
+        # and keys are rebuilt only when it does.
+        sig = (None if pair_hit is None else pair_hit.tobytes(), None if wall_hit is None else wall_hit.tobytes())
+        lay = self._layout
+        if lay is None or lay.pairs is not pairs or lay.sig != sig:
+            lay = self._layout = self._make_layout(pairs, sig, pair_hit, wall_hit)
+        n_parts, delta_parts = [], []
+        if lay.P:
+            if lay.t is not None:  # only some candidate pairs touch
+                d, dist, delta_p = d.take(lay.t, 0), dist.take(lay.t), delta_p.take(lay.t)
+            n_parts.append(d / dist[:, None])
+            delta_parts.append(delta_p)
+        v_wall = None
+        if len(lay.gi):
+            dw = delta_w.take(lay.flat)  # delta_w[gi, wk]
+            if self.moving_walls:
+                n_w = n.take(lay.wk, 0)
+                v_wall = self._wall_velocity(lay.wk, x.take(lay.gi, 0) - (self.r.take(lay.gi) - dw)[:, None] * n_w,
+                                             rates)
+                n_parts.append(-n_w)
+            else:
+                n_parts.append(lay.fixed_n)
+            delta_parts.append(dw)
+        if not n_parts:
+            return lay.i, lay.j, lay.key, np.zeros((0, 3)), np.zeros(0), None, 0
+        if len(n_parts) == 1:
+            return lay.i, lay.j, lay.key, n_parts[0], delta_parts[0], v_wall, lay.P
+        return lay.i, lay.j, lay.key, np.concatenate(n_parts), np.concatenate(delta_parts), v_wall, lay.P
+
+    def _make_layout(self, pairs, sig, pair_hit, wall_hit):
+        """The rows of the contacts that touch (pair_hit over the candidate pairs,
+        wall_hit over grains x walls), grain pairs first."""
+        N, W = self.N, self.W
+        P, t = 0, None
+        i_parts, j_parts = [], []
+        if pair_hit is not None:
+            a, b, _ = pairs
+            P = int(np.count_nonzero(pair_hit))
+            if P < len(pair_hit):
+                t = pair_hit.nonzero()[0]
+                a, b = a.take(t), b.take(t)
+            if P:
+                i_parts.append(a)
+                j_parts.append(b)
+        z = np.zeros(0, np.int64)
+        gi = wk = z
+        if wall_hit is not None:
+            gi, wk = wall_hit.nonzero()
             if len(gi):
-                dw = delta[gi, wk]
-                n_w = n.take(wk, 0)
-                vw = np.zeros((len(gi), 3))
-                if self.moving_walls:
-                    vw = self._wall_velocity(wk, self.x.take(gi, 0) - (self.r.take(gi) - dw)[:, None] * n_w, rates)
-                parts.append((gi, N + wk, -n_w, dw, vw))
-        if not parts:
-            z = np.zeros(0, np.int64)
-            return z, z, z, np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3)), 0
-        i, j, n, delta, v_j = parts[0] if len(parts) == 1 else [np.concatenate(c) for c in zip(*parts)]
-        return i, j, i * (N + W) + j, n, delta, v_j, P
+                i_parts.append(gi)
+                j_parts.append(N + wk)
+        i = z if not i_parts else i_parts[0] if len(i_parts) == 1 else np.concatenate(i_parts)
+        j = z if not j_parts else j_parts[0] if len(j_parts) == 1 else np.concatenate(j_parts)
+        fixed_n = None if self.moving_walls else -self.wall_n0.take(wk, 0)
+        on = np.concatenate((i, j[:P])) if P else i  # the rows' grains, then the pairs' second grains
+        return _Layout(pairs, sig, P, t, gi, wk, gi * W + wk, fixed_n, i, j, i * (N + W) + j, on)
 
     # ------------------------------------------------------------ forces
     def _forces(self, elapsed=None):
@@ -230,9 +284,14 @@ class Simulation:
         time over which the springs are loaded (one step, or 0 at setup)."""
         dt = self.dt if elapsed is None else elapsed
         N = self.N
-        i, j, key, n, delta, v_j, P = self._contacts()  # rows :P are grain pairs
-        # Relative velocity of i's contact point with respect to j's (docs/law.md step 1).
-        v_rel = self.v.take(i, 0) - v_j
+        i, j, key, n, delta, v_wall, P = self._contacts()  # rows :P are grain pairs
+        # Relative velocity of i's contact point with respect to j's (docs/law.md step 1);
+        # a fixed wall's is zero, and v - 0 = v.
+        v_rel = self.v.take(i, 0)
+        if P:
+            v_rel[:P] -= self.v.take(j[:P], 0)
+        if v_wall is not None:
+            v_rel[P:] -= v_wall
         if self.rotation_on:
             # Lever arms from each centre to the contact point, taken midway in the overlap
             # (c = r - delta/2, as LIGGGHTS and YADE place it; a wall has none):
@@ -270,12 +329,13 @@ class Simulation:
             self._account_contact_energy(fn, delta, v_n, tan, dt)
 
         self.keys, self.D = key, D
-        self.slip_steps += int(np.count_nonzero(slipped))
+        self.n_slipped = int(np.count_nonzero(slipped))
+        self.slip_steps += self.n_slipped
         self.contacts = Contacts(i, j, key, n, fn, F_s, slipped, delta)
 
         F = -fn[:, None] * n + F_s
         # Forces on i, and the opposite on grain j (walls take nothing), in one scatter.
-        on = np.concatenate((i, j[:P])) if P else i
+        on = self._layout.on
         f = _scatter(on, np.concatenate((F, -F[:P])) if P else F, N)
         torque = None
         if self.rotation_on:
@@ -402,9 +462,9 @@ class Simulation:
     def _count_slips(self):
         if not len(self.rec_keys):
             return
-        key, slipped = self.contacts.key, self.contacts.slipped
-        if not np.count_nonzero(slipped):
+        if not self.n_slipped:
             return
+        key, slipped = self.contacts.key, self.contacts.slipped
         order = np.argsort(key)
         pos = np.minimum(np.searchsorted(key[order], self.rec_keys), len(key) - 1)
         hit = key[order][pos] == self.rec_keys
