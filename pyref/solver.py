@@ -16,7 +16,6 @@ import numpy as np
 from .laws import _dot, normal_force, rotate_history, tangential_force
 
 PAIR_BRUTE_FORCE_MAX = 64  # below this many grains, test every pair (no tree)
-SCATTER_ADD_AT_MAX = 64  # up to this many contact rows np.add.at sums forces faster than np.bincount
 
 
 class Contacts(NamedTuple):
@@ -45,6 +44,7 @@ class _Layout(NamedTuple):
     j: np.ndarray
     key: np.ndarray
     on: np.ndarray  # grain of each force row: i, then j of the pairs
+    on_flat: np.ndarray  # the force rows' components' places in an (N, 3) array, flat (_scatter)
 
 
 class Recording(NamedTuple):
@@ -121,6 +121,9 @@ class Simulation:
         # Fixed walls: points, normals, rates and offsets p.n never change.
         self.fixed_walls = (self.wall_p0, self.wall_n0, np.zeros(self.W), np.sum(self.wall_p0 * self.wall_n0, axis=1))
         self.turning_walls = [k for k, w in enumerate(s.walls) if w.rotation]
+        # Walls whose velocities are all +0 stay at p0 + 0 (what p0 + v*t*dt gives then).
+        self.walls_translate = bool(self.wall_v.any() or np.signbit(self.wall_v).any())
+        self.wall_p_still = self.wall_p0 + 0.0
         self.wall_turn = [_Rotation(w.rotation.axis) if w.rotation else None for w in s.walls]
         self.step_no = 0
 
@@ -155,7 +158,11 @@ class Simulation:
         during the last step."""
         if not self.moving_walls:
             return self.fixed_walls
-        p, n = self.wall_p0 + self.wall_v * self.step_no * self.dt, self.wall_n0.copy()
+        if self.walls_translate:
+            p = self.wall_p0 + self.wall_v * self.step_no * self.dt
+        else:
+            p = self.wall_p_still.copy()
+        n = self.wall_n0.copy()
         rates = np.zeros(self.W)
         for k in self.turning_walls:
             rot, nrot = self.walls[k].rotation, self.wall_rot_steps[k]
@@ -170,6 +177,9 @@ class Simulation:
         vw = self.wall_v.take(wk, 0)
         for k in rates.nonzero()[0]:
             rot = self.walls[k].rotation
+            if self.W == 1:  # every row is this wall's (the same sums as selecting them all)
+                vw += rates[k] * _cross(rot.axis[None, :], cp - rot.pivot)
+                continue
             sel = wk == k
             vw[sel] += rates[k] * _cross(rot.axis[None, :], cp[sel] - rot.pivot)  # (the axis row broadcasts)
         return vw
@@ -276,7 +286,8 @@ class Simulation:
         j = z if not j_parts else j_parts[0] if len(j_parts) == 1 else np.concatenate(j_parts)
         fixed_n = None if self.moving_walls else -self.wall_n0.take(wk, 0)
         on = np.concatenate((i, j[:P])) if P else i  # the rows' grains, then the pairs' second grains
-        return _Layout(pairs, sig, P, t, gi, wk, gi * W + wk, fixed_n, i, j, i * (N + W) + j, on)
+        return _Layout(pairs, sig, P, t, gi, wk, gi * W + wk, fixed_n, i, j, i * (N + W) + j, on,
+                       (on[:, None] * 3 + np.arange(3)).ravel())
 
     # ------------------------------------------------------------ forces
     def _forces(self, elapsed=None):
@@ -335,7 +346,7 @@ class Simulation:
 
         F = -fn[:, None] * n + F_s
         # Forces on i, and the opposite on grain j (walls take nothing), in one scatter.
-        on = self._layout.on
+        on = self._layout.on_flat
         f = _scatter(on, np.concatenate((F, -F[:P])) if P else F, N)
         torque = None
         if self.rotation_on:
@@ -555,14 +566,12 @@ def _all_finite(a):
     return np.count_nonzero(np.isfinite(a)) == a.size
 
 
-def _scatter(idx, values, n):
-    """Sum the rows of `values` (K, 3) into n rows by index, in the rows' order from zero
-    (np.add.at; np.bincount, which adds in the same order, is faster for many rows)."""
-    if len(idx) <= SCATTER_ADD_AT_MAX:
-        out = np.zeros((n, 3))
-        np.add.at(out, idx, values)
-        return out
-    flat = (idx[:, None] * 3 + np.arange(3)).ravel()
+def _scatter(flat, values, n):
+    """Sum the rows of `values` (K, 3) into n rows, component k of row r going to flat
+    place flat[3r + k], in the rows' order from zero (np.bincount adds in that order,
+    as np.add.at does, and is faster even on a few rows)."""
+    if not len(flat):
+        return np.zeros((n, 3))  # (np.bincount would give integers)
     return np.bincount(flat, values.ravel(), 3 * n).reshape(n, 3)
 
 
