@@ -237,28 +237,24 @@ class Simulation:
         lay = self._layout
         if lay is None or lay.pairs is not pairs or lay.sig != sig:
             lay = self._layout = self._make_layout(pairs, sig, pair_hit, wall_hit)
-        n_parts, delta_parts = [], []
-        if lay.P:
+        K, P = len(lay.i), lay.P
+        n_all, delta = np.empty((K, 3)), np.empty(K)  # the pairs' rows, then the walls'
+        if P:
             if lay.t is not None:  # only some candidate pairs touch
                 d, dist, delta_p = d.take(lay.t, 0), dist.take(lay.t), delta_p.take(lay.t)
-            n_parts.append(d / dist[:, None])
-            delta_parts.append(delta_p)
+            np.divide(d, dist[:, None], out=n_all[:P])
+            delta[:P] = delta_p
         v_wall = None
-        if len(lay.gi):
-            dw = delta_w.take(lay.flat)  # delta_w[gi, wk]
+        if K > P:
+            dw = delta_w.take(lay.flat, out=delta[P:])  # delta_w[gi, wk]
             if self.moving_walls:
                 n_w = n.take(lay.wk, 0)
                 v_wall = self._wall_velocity(lay.wk, x.take(lay.gi, 0) - (self.r.take(lay.gi) - dw)[:, None] * n_w,
                                              rates)
-                n_parts.append(-n_w)
+                np.negative(n_w, out=n_all[P:])
             else:
-                n_parts.append(lay.fixed_n)
-            delta_parts.append(dw)
-        if not n_parts:
-            return lay.i, lay.j, lay.key, np.zeros((0, 3)), np.zeros(0), None, 0
-        if len(n_parts) == 1:
-            return lay.i, lay.j, lay.key, n_parts[0], delta_parts[0], v_wall, lay.P
-        return lay.i, lay.j, lay.key, np.concatenate(n_parts), np.concatenate(delta_parts), v_wall, lay.P
+                n_all[P:] = lay.fixed_n
+        return lay.i, lay.j, lay.key, n_all, delta, v_wall, P
 
     def _make_layout(self, pairs, sig, pair_hit, wall_hit):
         """The rows of the contacts that touch (pair_hit over the candidate pairs,
@@ -344,10 +340,13 @@ class Simulation:
         self.slip_steps += self.n_slipped
         self.contacts = Contacts(i, j, key, n, fn, F_s, slipped, delta)
 
-        F = -fn[:, None] * n + F_s
-        # Forces on i, and the opposite on grain j (walls take nothing), in one scatter.
+        # Forces F on i, and -F on grain j (walls take nothing), in one scatter.
+        K = len(key)
+        F = np.empty((K + P, 3))
+        np.add(-fn[:, None] * n, F_s, out=F[:K])
+        np.negative(F[:P], out=F[K:])
         on = self._layout.on_flat
-        f = _scatter(on, np.concatenate((F, -F[:P])) if P else F, N)
+        f = _scatter(on, F, N)
         torque = None
         if self.rotation_on:
             # Torques (c_i n) x F_s on i and (-c_j n) x (-F_s) = c_j (n x F_s) on j.
@@ -469,17 +468,26 @@ class Simulation:
         self.rec_slips = np.zeros(len(pairs), np.int64)
         self.rec_walls = [k for k, w in enumerate(self.walls) if w.name in out.walls]
         self.rows = []
+        self._rec_rows_of = None  # the _Layout that _recorded_rows belong to
 
     def _count_slips(self):
         if not len(self.rec_keys):
             return
         if not self.n_slipped:
             return
-        key, slipped = self.contacts.key, self.contacts.slipped
-        order = np.argsort(key)
-        pos = np.minimum(np.searchsorted(key[order], self.rec_keys), len(key) - 1)
-        hit = key[order][pos] == self.rec_keys
-        self.rec_slips[hit] += slipped[order][pos[hit]]
+        rec, row = self._recorded_rows()
+        self.rec_slips[rec] += self.contacts.slipped[row]
+
+    def _recorded_rows(self):
+        """The recorded contacts that touch (indices into rec_keys) and their rows in
+        self.contacts; kept while the same contacts touch."""
+        lay = self._layout
+        if self._rec_rows_of is not lay:
+            lookup = {int(k): idx for idx, k in enumerate(lay.key)}
+            hit = [(r, lookup[int(k)]) for r, k in enumerate(self.rec_keys) if int(k) in lookup]
+            self._rec_rows = (np.array([h[0] for h in hit], np.int64), np.array([h[1] for h in hit], np.int64))
+            self._rec_rows_of = lay
+        return self._rec_rows
 
     def record_row(self):
         """One row of the Recording (see there), as a tuple of arrays."""
@@ -488,11 +496,8 @@ class Simulation:
         fn, ft = np.zeros(C), np.zeros((C, d))
         if C:
             c = self.contacts
-            lookup = {int(k): idx for idx, k in enumerate(c.key)}
-            for r, k in enumerate(self.rec_keys):
-                idx = lookup.get(int(k))
-                if idx is not None:
-                    fn[r], ft[r] = c.fn[idx], c.force[idx, :d] * self.rec_sign[r]
+            rec, row = self._recorded_rows()
+            fn[rec], ft[rec] = c.fn[row], c.force[row, :d] * self.rec_sign[rec, None]
         spin = None
         if self.rotation_on:
             spin = self.w.take(g, 0)[:, 2:] if d == 2 else self.w.take(g, 0)
