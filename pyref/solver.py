@@ -108,6 +108,8 @@ class Simulation:
         self.turning_gravity = self.gravity_on and bool(s.gravity_rate or s.gravity_spinup[1])
         # Per-step constants, computed once (the same numbers the step would compute).
         self.half_dt = 0.5 * self.dt
+        # The step's factors as 0-d arrays: numpy multiplies by them faster than by floats.
+        self.dt_0d, self.half_dt_0d = np.array(self.dt), np.array(self.half_dt)
         self.m_col, self.inertia_col, self.r_col = self.m[:, None], self.inertia[:, None], self.r[:, None]
         self.weight = self.m_col * self.g
         # The same divisors repeated along the 3 components: dividing equal shapes skips
@@ -121,8 +123,11 @@ class Simulation:
         self.wall_v = np.array([w.velocity for w in s.walls]).reshape(-1, 3)
         self.wall_rot_steps = [s.rotation_steps(w) if w.rotation else 0 for w in s.walls]
         self.wall_rate = [s.rotation_rate(w) if w.rotation else 0.0 for w in s.walls]
-        # Fixed walls: points, normals, rates and offsets p.n never change.
-        self.fixed_walls = (self.wall_p0, self.wall_n0, np.zeros(self.W), np.sum(self.wall_p0 * self.wall_n0, axis=1))
+        # Fixed walls: points, normals, rates and offsets p.n never change. The offsets and
+        # radii are repeated for every grain x wall (no broadcasting in _contacts).
+        self.fixed_walls = (self.wall_p0, self.wall_n0, np.zeros(self.W),
+                            np.tile(np.sum(self.wall_p0 * self.wall_n0, axis=1), (self.N, 1)))
+        self.r_walls = np.repeat(self.r_col, self.W, 1)
         self.turning_walls = [k for k, w in enumerate(s.walls) if w.rotation]
         # Walls whose velocities are all +0 stay at p0 + 0 (what p0 + v*t*dt gives then).
         self.walls_translate = bool(self.wall_v.any() or np.signbit(self.wall_v).any())
@@ -157,8 +162,8 @@ class Simulation:
 
     # ------------------------------------------------------------ walls
     def _wall_state(self):
-        """Wall points, normals and offsets p.n at the current time, and angular rates
-        during the last step."""
+        """Wall points, normals and offsets p.n (per wall, or per grain x wall for fixed
+        walls) at the current time, and angular rates during the last step."""
         if not self.moving_walls:
             return self.fixed_walls
         if self.walls_translate:
@@ -229,11 +234,11 @@ class Simulation:
             d = x.take(b, 0) - x.take(a, 0)
             dist = np.sqrt(_dot(d, d))
             delta_p = reach - dist
-            pair_hit = delta_p > 0.0
+            pair_hit = delta_p > _ZERO
         if self.W:
             p, n, rates, offset = self._wall_state()
-            delta_w = self.r_col - (x @ n.T - offset)
-            wall_hit = delta_w > 0.0
+            delta_w = self.r_walls - (x @ n.T - offset)
+            wall_hit = delta_w > _ZERO
         # Which contacts touch rarely changes from one step to the next: the rows' indices
         # and keys are rebuilt only when it does.
         sig = (None if pair_hit is None else pair_hit.tobytes(), None if wall_hit is None else wall_hit.tobytes())
@@ -387,18 +392,17 @@ class Simulation:
 
     # ------------------------------------------------------------ integration
     def step(self):
-        dt = self.dt
         a = self.f / self.m_rows
-        v_half = self.v + self.half_dt * a  # (0.5 * dt) * a
+        v_half = self.v + self.half_dt_0d * a  # (0.5 * dt) * a
         if self.any_imposed:
             v_half = np.where(self.imposed, self.v_imposed, v_half)
         x_old = self.x
-        self.x = self.x + dt * v_half
+        self.x = self.x + self.dt_0d * v_half
         if self.dim == 2:
             self.x[:, 2] = 0.0
             v_half[:, 2] = 0.0
         if self.rotation_on:
-            w_half = self.w + self.half_dt * self.torque / self.inertia_rows
+            w_half = self.w + self.half_dt_0d * self.torque / self.inertia_rows
             if self.dim == 2:
                 w_half[:, :2] = 0.0
             if self.any_fixed:
@@ -409,13 +413,13 @@ class Simulation:
             self.w = w_half
         self.step_no += 1
         self.f, self.torque = self._forces()
-        self.v = v_half + self.half_dt * self.f / self.m_rows
+        self.v = v_half + self.half_dt_0d * self.f / self.m_rows
         if self.any_imposed:
             self.v = np.where(self.imposed, self.v_imposed, self.v)
         if self.dim == 2:
             self.v[:, 2] = 0.0
         if self.rotation_on:
-            self.w = w_half + self.half_dt * self.torque / self.inertia_rows
+            self.w = w_half + self.half_dt_0d * self.torque / self.inertia_rows
             if self.dim == 2:
                 self.w[:, :2] = 0.0
             if self.any_fixed:
@@ -558,6 +562,8 @@ class Simulation:
             progress(steps, steps)
         return self.recording(steps, time.perf_counter() - t0)
 
+
+_ZERO = np.zeros(())  # numpy compares with a 0-d array faster than with the float 0.0
 
 # Component k of a x b is a[k+1] b[k+2] - a[k+2] b[k+1] (indices mod 3).
 _NEXT, _AFTER_NEXT = np.array([1, 2, 0]), np.array([2, 0, 1])
