@@ -325,7 +325,7 @@ class Simulation:
         # ended contacts are dropped (their keys are simply not carried).
         if not self.p.has_spring:
             D = np.zeros((len(key), 3))
-        elif key.tobytes() == self.keys.tobytes():  # (np.array_equal, without its overhead)
+        elif key is self.keys or key.tobytes() == self.keys.tobytes():  # (np.array_equal, without its overhead)
             D = rotate_history(self.D, n)  # same contacts as last step (the usual case)
         else:
             D = np.zeros((len(key), 3))
