@@ -13,7 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .laws import _dot, normal_force, rotate_history, tangential_force
+from .laws import _count_nonzero, _dot, normal_force, rotate_history, tangential_force
 
 PAIR_BRUTE_FORCE_MAX = 64  # below this many grains, test every pair (no tree)
 
@@ -43,8 +43,7 @@ class _Layout(NamedTuple):
     i: np.ndarray
     j: np.ndarray
     key: np.ndarray
-    on: np.ndarray  # grain of each force row: i, then j of the pairs
-    on_flat: np.ndarray  # the force rows' components' places in an (N, 3) array, flat (_scatter)
+    on_flat: np.ndarray  # force rows (on i, then on the pairs' j): their components' flat places in (N, 3)
 
 
 class Recording(NamedTuple):
@@ -178,7 +177,7 @@ class Simulation:
             p[k] = rot.pivot + R @ (p[k] - rot.pivot)
             n[k] = R @ n[k]
             rates[k] = self.wall_rate[k] if 1 <= self.step_no <= nrot else 0.0
-        return p, n, rates, (p * n).sum(axis=1)
+        return p, n, rates, np.add.reduce(p * n, 1)  # (p * n).sum(axis=1), without its Python layer
 
     def _wall_velocity(self, wk, cp, rates):
         """Velocity of walls wk at contact points cp during the last step."""
@@ -290,7 +289,7 @@ class Simulation:
         j = z if not j_parts else j_parts[0] if len(j_parts) == 1 else np.concatenate(j_parts)
         fixed_n = None if self.moving_walls else -self.wall_n0.take(wk, 0)
         on = np.concatenate((i, j[:P])) if P else i  # the rows' grains, then the pairs' second grains
-        return _Layout(pairs, sig, P, t, gi, wk, gi * W + wk, fixed_n, i, j, i * (N + W) + j, on,
+        return _Layout(pairs, sig, P, t, gi, wk, gi * W + wk, fixed_n, i, j, i * (N + W) + j,
                        (on[:, None] * 3 + np.arange(3)).ravel())
 
     # ------------------------------------------------------------ forces
@@ -344,7 +343,7 @@ class Simulation:
             self._account_contact_energy(fn, delta, v_n, tan, dt)
 
         self.keys, self.D = key, D
-        self.n_slipped = int(np.count_nonzero(slipped))
+        self.n_slipped = int(_count_nonzero(slipped))
         self.slip_steps += self.n_slipped
         self.contacts = Contacts(i, j, key, n, fn, F_s, slipped, delta)
 
@@ -577,7 +576,7 @@ def _cross(a, b):
 
 def _all_finite(a):
     """np.isfinite(a).all(), faster on a few grains."""
-    return np.count_nonzero(np.isfinite(a)) == a.size
+    return _count_nonzero(np.isfinite(a)) == a.size
 
 
 def _scatter(flat, values, n):
