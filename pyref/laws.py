@@ -27,6 +27,12 @@ SLIP_TIMINGS = ("step", "exact")
 SETTLED = 1e-8
 MAX_EXPLICIT_SLIPS = 100
 
+try:  # numpy's C einsum and count_nonzero themselves: on a few rows their Python layers
+    # (np.einsum, np.count_nonzero) cost as much again as the work, or ten times as much
+    from numpy._core.multiarray import c_einsum as _einsum, count_nonzero as _count_nonzero
+except ImportError:  # numpy < 2
+    _einsum, _count_nonzero = np.einsum, np.count_nonzero
+
 
 @dataclass
 class LawParams:
@@ -119,12 +125,12 @@ def normal_force(delta, v_n, p: LawParams):
 def rotate_history(D, n):
     """Turn the spring elongation into the current tangent plane, keeping its length
     (the 3D form; when D already lies in the plane, as in 2D on a fixed wall, nothing moves)."""
-    dn = np.einsum("ij,ij->i", D, n)
+    dn = _einsum("ij,ij->i", D, n)
     if not _any(dn):
         return D
-    old = np.einsum("ij,ij->i", D, D)
+    old = _einsum("ij,ij->i", D, D)
     D = D - dn[:, None] * n
-    new = np.einsum("ij,ij->i", D, D)
+    new = _einsum("ij,ij->i", D, D)
     scale = np.sqrt(old / np.maximum(new, 1e-300))
     return D * np.where(new > 0, scale, 1.0)[:, None]
 
@@ -162,7 +168,7 @@ def tangential_force(D, V_s, fn, dt, p: LawParams, energy=False) -> TangentialSt
         F_0 = -p.ks * D_start - p.nu_s * V_s
         slip = slip | (_dot(F_0, F_0) >= limit * limit)
         F_s, stick_share = F_t, np.ones(len(fn))
-        k = np.flatnonzero(slip)
+        k = slip.nonzero()[0]  # (np.flatnonzero's Python layer costs more on a few rows)
         if len(k):
             F_s, D = F_t.copy(), D.copy()
             F_s[k], D[k], stick_share[k] = _exact_slips(D_start[k], V_s[k], fn[k], dt, p, mu_s, mu_k)
@@ -205,7 +211,7 @@ def _exact_slips(D0, V_s, fn, dt, p, mu_s, mu_k):
     f_min = (2.0 * mu_k - mu_s) * fn
     r = (2.0 * mu_k - mu_s) / mu_s  # Fmin/T, a parameter: exactly 1 iff mu_k = mu_s
     speed = np.sqrt(_dot(V_s, V_s))
-    u = np.divide(-V_s, speed[:, None], out=np.zeros_like(V_s), where=speed[:, None] > 0)
+    u = np.divide(-V_s, speed[:, None], out=np.zeros(V_s.shape, V_s.dtype), where=speed[:, None] > 0)
     rate = p.ks * speed * dt
     # After a slip the trial force restarts from Fmin*t + kept*u (E3): the spring holds
     # Fmin and the dashpot adds nu_s|V_s| (reset "spring"), or both hold Fmin ("total").
@@ -228,7 +234,7 @@ def _exact_slips(D0, V_s, fn, dt, p, mu_s, mu_k):
         active[i] = False
 
     while _any(active):
-        a = np.flatnonzero(active)
+        a = active.nonzero()[0]
         # E2. Next slip: the first theta at which |F| reaches T. Before the step's first
         # slip the force may already be at or above T (Fn fell, or V_s jumped): slip now.
         f = _dot(F[a], u[a])
@@ -320,18 +326,19 @@ def _plastic_flow(F, u, k_rest, T):
 
 
 def _dot(a, b):
-    return np.einsum("ij,ij->i", a, b)
+    return _einsum("ij,ij->i", a, b)
 
 
 def _any(a):
     """a.any(), faster on the few rows of a small scene (where the step's cost is numpy's
     per-call overhead)."""
-    return np.count_nonzero(a) > 0
+    return _count_nonzero(a) > 0
 
 
 def _unit(V):
     mag = np.sqrt(_dot(V, V))
-    return np.divide(V, mag[:, None], out=np.zeros_like(V), where=mag[:, None] > 0), mag
+    # (np.zeros: np.zeros_like costs five times as much on a few rows)
+    return np.divide(V, mag[:, None], out=np.zeros(V.shape, V.dtype), where=mag[:, None] > 0), mag
 
 
 def _coulomb(V_s, fn, p):

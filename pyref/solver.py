@@ -13,10 +13,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .laws import _dot, normal_force, rotate_history, tangential_force
+from .laws import _count_nonzero, _dot, normal_force, rotate_history, tangential_force
 
 PAIR_BRUTE_FORCE_MAX = 64  # below this many grains, test every pair (no tree)
-SCATTER_ADD_AT_MAX = 64  # up to this many contact rows np.add.at sums forces faster than np.bincount
 
 
 class Contacts(NamedTuple):
@@ -29,6 +28,22 @@ class Contacts(NamedTuple):
     force: np.ndarray  # (K, 3) tangential force on i
     slipped: np.ndarray  # bool: slipped during the last step
     delta: np.ndarray  # overlap
+
+
+class _Layout(NamedTuple):
+    """The rows of the touching contacts, kept while the same contacts touch."""
+    pairs: tuple | None  # the candidate pairs they were found among
+    sig: tuple  # bytes of the touching masks (pairs, grains x walls)
+    P: int  # touching grain pairs (the first rows)
+    t: np.ndarray | None  # their indices among the candidates; None: all touch
+    gi: np.ndarray  # grain of each wall row
+    wk: np.ndarray  # wall of each wall row
+    flat: np.ndarray  # gi * W + wk, the rows' places in the grains x walls overlaps
+    fixed_n: np.ndarray | None  # the wall rows' normals (i -> wall) when walls are fixed
+    i: np.ndarray
+    j: np.ndarray
+    key: np.ndarray
+    on_flat: np.ndarray  # force rows (on i, then on the pairs' j): their components' flat places in (N, 3)
 
 
 class Recording(NamedTuple):
@@ -92,8 +107,13 @@ class Simulation:
         self.turning_gravity = self.gravity_on and bool(s.gravity_rate or s.gravity_spinup[1])
         # Per-step constants, computed once (the same numbers the step would compute).
         self.half_dt = 0.5 * self.dt
+        # The step's factors as 0-d arrays: numpy multiplies by them faster than by floats.
+        self.dt_0d, self.half_dt_0d = np.array(self.dt), np.array(self.half_dt)
         self.m_col, self.inertia_col, self.r_col = self.m[:, None], self.inertia[:, None], self.r[:, None]
         self.weight = self.m_col * self.g
+        # The same divisors repeated along the 3 components: dividing equal shapes skips
+        # numpy's broadcasting, which costs more than the division on a few grains.
+        self.m_rows, self.inertia_rows = np.repeat(self.m_col, 3, 1), np.repeat(self.inertia_col, 3, 1)
 
         self.walls = s.walls
         self.W = len(s.walls)
@@ -102,9 +122,15 @@ class Simulation:
         self.wall_v = np.array([w.velocity for w in s.walls]).reshape(-1, 3)
         self.wall_rot_steps = [s.rotation_steps(w) if w.rotation else 0 for w in s.walls]
         self.wall_rate = [s.rotation_rate(w) if w.rotation else 0.0 for w in s.walls]
-        # Fixed walls: points, normals, rates and offsets p.n never change.
-        self.fixed_walls = (self.wall_p0, self.wall_n0, np.zeros(self.W), np.sum(self.wall_p0 * self.wall_n0, axis=1))
+        # Fixed walls: points, normals, rates and offsets p.n never change. The offsets and
+        # radii are repeated for every grain x wall (no broadcasting in _contacts).
+        self.fixed_walls = (self.wall_p0, self.wall_n0, np.zeros(self.W),
+                            np.tile(np.sum(self.wall_p0 * self.wall_n0, axis=1), (self.N, 1)))
+        self.r_walls = np.repeat(self.r_col, self.W, 1)
         self.turning_walls = [k for k, w in enumerate(s.walls) if w.rotation]
+        # Walls whose velocities are all +0 stay at p0 + 0 (what p0 + v*t*dt gives then).
+        self.walls_translate = bool(self.wall_v.any() or np.signbit(self.wall_v).any())
+        self.wall_p_still = self.wall_p0 + 0.0
         self.wall_turn = [_Rotation(w.rotation.axis) if w.rotation else None for w in s.walls]
         self.step_no = 0
 
@@ -113,6 +139,7 @@ class Simulation:
         self.D = np.zeros((0, 3))
         self.pairs = None  # candidate pairs: (a, b, r_a + r_b), a < b
         self.x_at_build = None
+        self._layout = None  # rows of the touching contacts (_make_layout)
         self.skin = 0.2 * float(self.r.min())
 
         # energy books: when the scene records them, or when asked (tests)
@@ -134,11 +161,15 @@ class Simulation:
 
     # ------------------------------------------------------------ walls
     def _wall_state(self):
-        """Wall points, normals and offsets p.n at the current time, and angular rates
-        during the last step."""
+        """Wall points, normals and offsets p.n (per wall, or per grain x wall for fixed
+        walls) at the current time, and angular rates during the last step."""
         if not self.moving_walls:
             return self.fixed_walls
-        p, n = self.wall_p0 + self.wall_v * self.step_no * self.dt, self.wall_n0.copy()
+        if self.walls_translate:
+            p = self.wall_p0 + self.wall_v * self.step_no * self.dt
+        else:
+            p = self.wall_p_still.copy()
+        n = self.wall_n0.copy()
         rates = np.zeros(self.W)
         for k in self.turning_walls:
             rot, nrot = self.walls[k].rotation, self.wall_rot_steps[k]
@@ -146,13 +177,16 @@ class Simulation:
             p[k] = rot.pivot + R @ (p[k] - rot.pivot)
             n[k] = R @ n[k]
             rates[k] = self.wall_rate[k] if 1 <= self.step_no <= nrot else 0.0
-        return p, n, rates, (p * n).sum(axis=1)
+        return p, n, rates, np.add.reduce(p * n, 1)  # (p * n).sum(axis=1), without its Python layer
 
     def _wall_velocity(self, wk, cp, rates):
         """Velocity of walls wk at contact points cp during the last step."""
         vw = self.wall_v.take(wk, 0)
         for k in rates.nonzero()[0]:
             rot = self.walls[k].rotation
+            if self.W == 1:  # every row is this wall's (the same sums as selecting them all)
+                vw += rates[k] * _cross(rot.axis[None, :], cp - rot.pivot)
+                continue
             sel = wk == k
             vw[sel] += rates[k] * _cross(rot.axis[None, :], cp[sel] - rot.pivot)  # (the axis row broadcasts)
         return vw
@@ -188,41 +222,75 @@ class Simulation:
         return a, b, self.r[a] + self.r[b]
 
     def _contacts(self):
-        """All touching grain-grain and grain-wall contacts: i, j, key, n (i -> j), overlap
-        and the velocity of j's contact point; the grain pairs come first (how many: the
-        last value)."""
-        N, W = self.N, self.W
-        parts = []  # (i, j, n, delta, v_j) of the touching pairs, then of the walls
-        P = 0  # touching pairs
+        """All touching grain-grain and grain-wall contacts: i, j, key, n (i -> j), overlap,
+        the velocity of the walls' contact points (None when the walls are fixed: zero)
+        and how many of the rows, the first ones, are grain pairs."""
+        x = self.x
         pairs = self._candidate_pairs()
+        pair_hit = wall_hit = None
         if pairs is not None and len(pairs[0]):
             a, b, reach = pairs
-            d = self.x.take(b, 0) - self.x.take(a, 0)
+            d = x.take(b, 0) - x.take(a, 0)
             dist = np.sqrt(_dot(d, d))
-            delta = reach - dist
-            touching = delta > 0.0
-            P = np.count_nonzero(touching)
-            if P:
-                if P < len(touching):
-                    t = touching.nonzero()[0]
-                    a, b, d, dist, delta = a.take(t), b.take(t), d.take(t, 0), dist.take(t), delta.take(t)
-                parts.append((a, b, d / dist[:, None], delta, self.v.take(b, 0)))
-        if W:
+            delta_p = reach - dist
+            pair_hit = delta_p > _ZERO
+        if self.W:
             p, n, rates, offset = self._wall_state()
-            delta = self.r_col - (self.x @ n.T - offset)
-            gi, wk = (delta > 0.0).nonzero()
+            delta_w = self.r_walls - (x @ n.T - offset)
+            wall_hit = delta_w > _ZERO
+        # Which contacts touch rarely changes from one step to the next: the rows' indices
+        # and keys are rebuilt only when it does.
+        sig = (None if pair_hit is None else pair_hit.tobytes(), None if wall_hit is None else wall_hit.tobytes())
+        lay = self._layout
+        if lay is None or lay.pairs is not pairs or lay.sig != sig:
+            lay = self._layout = self._make_layout(pairs, sig, pair_hit, wall_hit)
+        K, P = len(lay.i), lay.P
+        n_all, delta = np.empty((K, 3)), np.empty(K)  # the pairs' rows, then the walls'
+        if P:
+            if lay.t is not None:  # only some candidate pairs touch
+                d, dist, delta_p = d.take(lay.t, 0), dist.take(lay.t), delta_p.take(lay.t)
+            np.divide(d, dist[:, None], out=n_all[:P])
+            delta[:P] = delta_p
+        v_wall = None
+        if K > P:
+            dw = delta_w.take(lay.flat, out=delta[P:])  # delta_w[gi, wk]
+            if self.moving_walls:
+                n_w = n.take(lay.wk, 0)
+                v_wall = self._wall_velocity(lay.wk, x.take(lay.gi, 0) - (self.r.take(lay.gi) - dw)[:, None] * n_w,
+                                             rates)
+                np.negative(n_w, out=n_all[P:])
+            else:
+                n_all[P:] = lay.fixed_n
+        return lay.i, lay.j, lay.key, n_all, delta, v_wall, P
+
+    def _make_layout(self, pairs, sig, pair_hit, wall_hit):
+        """The rows of the contacts that touch (pair_hit over the candidate pairs,
+        wall_hit over grains x walls), grain pairs first."""
+        N, W = self.N, self.W
+        P, t = 0, None
+        i_parts, j_parts = [], []
+        if pair_hit is not None:
+            a, b, _ = pairs
+            P = int(np.count_nonzero(pair_hit))
+            if P < len(pair_hit):
+                t = pair_hit.nonzero()[0]
+                a, b = a.take(t), b.take(t)
+            if P:
+                i_parts.append(a)
+                j_parts.append(b)
+        z = np.zeros(0, np.int64)
+        gi = wk = z
+        if wall_hit is not None:
+            gi, wk = wall_hit.nonzero()
             if len(gi):
-                dw = delta[gi, wk]
-                n_w = n.take(wk, 0)
-                vw = np.zeros((len(gi), 3))
-                if self.moving_walls:
-                    vw = self._wall_velocity(wk, self.x.take(gi, 0) - (self.r.take(gi) - dw)[:, None] * n_w, rates)
-                parts.append((gi, N + wk, -n_w, dw, vw))
-        if not parts:
-            z = np.zeros(0, np.int64)
-            return z, z, z, np.zeros((0, 3)), np.zeros(0), np.zeros((0, 3)), 0
-        i, j, n, delta, v_j = parts[0] if len(parts) == 1 else [np.concatenate(c) for c in zip(*parts)]
-        return i, j, i * (N + W) + j, n, delta, v_j, P
+                i_parts.append(gi)
+                j_parts.append(N + wk)
+        i = z if not i_parts else i_parts[0] if len(i_parts) == 1 else np.concatenate(i_parts)
+        j = z if not j_parts else j_parts[0] if len(j_parts) == 1 else np.concatenate(j_parts)
+        fixed_n = None if self.moving_walls else -self.wall_n0.take(wk, 0)
+        on = np.concatenate((i, j[:P])) if P else i  # the rows' grains, then the pairs' second grains
+        return _Layout(pairs, sig, P, t, gi, wk, gi * W + wk, fixed_n, i, j, i * (N + W) + j,
+                       (on[:, None] * 3 + np.arange(3)).ravel())
 
     # ------------------------------------------------------------ forces
     def _forces(self, elapsed=None):
@@ -230,9 +298,14 @@ class Simulation:
         time over which the springs are loaded (one step, or 0 at setup)."""
         dt = self.dt if elapsed is None else elapsed
         N = self.N
-        i, j, key, n, delta, v_j, P = self._contacts()  # rows :P are grain pairs
-        # Relative velocity of i's contact point with respect to j's (docs/law.md step 1).
-        v_rel = self.v.take(i, 0) - v_j
+        i, j, key, n, delta, v_wall, P = self._contacts()  # rows :P are grain pairs
+        # Relative velocity of i's contact point with respect to j's (docs/law.md step 1);
+        # a fixed wall's is zero, and v - 0 = v.
+        v_rel = self.v.take(i, 0)
+        if P:
+            v_rel[:P] -= self.v.take(j[:P], 0)
+        if v_wall is not None:
+            v_rel[P:] -= v_wall
         if self.rotation_on:
             # Lever arms from each centre to the contact point, taken midway in the overlap
             # (c = r - delta/2, as LIGGGHTS and YADE place it; a wall has none):
@@ -251,7 +324,7 @@ class Simulation:
         # ended contacts are dropped (their keys are simply not carried).
         if not self.p.has_spring:
             D = np.zeros((len(key), 3))
-        elif key.tobytes() == self.keys.tobytes():  # (np.array_equal, without its overhead)
+        elif key is self.keys or key.tobytes() == self.keys.tobytes():  # (np.array_equal, without its overhead)
             D = rotate_history(self.D, n)  # same contacts as last step (the usual case)
         else:
             D = np.zeros((len(key), 3))
@@ -270,13 +343,17 @@ class Simulation:
             self._account_contact_energy(fn, delta, v_n, tan, dt)
 
         self.keys, self.D = key, D
-        self.slip_steps += int(np.count_nonzero(slipped))
+        self.n_slipped = int(_count_nonzero(slipped))
+        self.slip_steps += self.n_slipped
         self.contacts = Contacts(i, j, key, n, fn, F_s, slipped, delta)
 
-        F = -fn[:, None] * n + F_s
-        # Forces on i, and the opposite on grain j (walls take nothing), in one scatter.
-        on = np.concatenate((i, j[:P])) if P else i
-        f = _scatter(on, np.concatenate((F, -F[:P])) if P else F, N)
+        # Forces F on i, and -F on grain j (walls take nothing), in one scatter.
+        K = len(key)
+        F = np.empty((K + P, 3))
+        np.add(-fn[:, None] * n, F_s, out=F[:K])
+        np.negative(F[:P], out=F[K:])
+        on = self._layout.on_flat
+        f = _scatter(on, F, N)
         torque = None
         if self.rotation_on:
             # Torques (c_i n) x F_s on i and (-c_j n) x (-F_s) = c_j (n x F_s) on j.
@@ -314,18 +391,17 @@ class Simulation:
 
     # ------------------------------------------------------------ integration
     def step(self):
-        dt = self.dt
-        a = self.f / self.m_col
-        v_half = self.v + self.half_dt * a  # (0.5 * dt) * a
+        a = self.f / self.m_rows
+        v_half = self.v + self.half_dt_0d * a  # (0.5 * dt) * a
         if self.any_imposed:
             v_half = np.where(self.imposed, self.v_imposed, v_half)
         x_old = self.x
-        self.x = self.x + dt * v_half
+        self.x = self.x + self.dt_0d * v_half
         if self.dim == 2:
             self.x[:, 2] = 0.0
             v_half[:, 2] = 0.0
         if self.rotation_on:
-            w_half = self.w + self.half_dt * self.torque / self.inertia_col
+            w_half = self.w + self.half_dt_0d * self.torque / self.inertia_rows
             if self.dim == 2:
                 w_half[:, :2] = 0.0
             if self.any_fixed:
@@ -336,13 +412,13 @@ class Simulation:
             self.w = w_half
         self.step_no += 1
         self.f, self.torque = self._forces()
-        self.v = v_half + self.half_dt * self.f / self.m_col
+        self.v = v_half + self.half_dt_0d * self.f / self.m_rows
         if self.any_imposed:
             self.v = np.where(self.imposed, self.v_imposed, self.v)
         if self.dim == 2:
             self.v[:, 2] = 0.0
         if self.rotation_on:
-            self.w = w_half + self.half_dt * self.torque / self.inertia_col
+            self.w = w_half + self.half_dt_0d * self.torque / self.inertia_rows
             if self.dim == 2:
                 self.w[:, :2] = 0.0
             if self.any_fixed:
@@ -398,17 +474,26 @@ class Simulation:
         self.rec_slips = np.zeros(len(pairs), np.int64)
         self.rec_walls = [k for k, w in enumerate(self.walls) if w.name in out.walls]
         self.rows = []
+        self._rec_rows_of = None  # the _Layout that _recorded_rows belong to
 
     def _count_slips(self):
         if not len(self.rec_keys):
             return
-        key, slipped = self.contacts.key, self.contacts.slipped
-        if not np.count_nonzero(slipped):
+        if not self.n_slipped:
             return
-        order = np.argsort(key)
-        pos = np.minimum(np.searchsorted(key[order], self.rec_keys), len(key) - 1)
-        hit = key[order][pos] == self.rec_keys
-        self.rec_slips[hit] += slipped[order][pos[hit]]
+        rec, row = self._recorded_rows()
+        self.rec_slips[rec] += self.contacts.slipped[row]
+
+    def _recorded_rows(self):
+        """The recorded contacts that touch (indices into rec_keys) and their rows in
+        self.contacts; kept while the same contacts touch."""
+        lay = self._layout
+        if self._rec_rows_of is not lay:
+            lookup = {int(k): idx for idx, k in enumerate(lay.key)}
+            hit = [(r, lookup[int(k)]) for r, k in enumerate(self.rec_keys) if int(k) in lookup]
+            self._rec_rows = (np.array([h[0] for h in hit], np.int64), np.array([h[1] for h in hit], np.int64))
+            self._rec_rows_of = lay
+        return self._rec_rows
 
     def record_row(self):
         """One row of the Recording (see there), as a tuple of arrays."""
@@ -417,11 +502,8 @@ class Simulation:
         fn, ft = np.zeros(C), np.zeros((C, d))
         if C:
             c = self.contacts
-            lookup = {int(k): idx for idx, k in enumerate(c.key)}
-            for r, k in enumerate(self.rec_keys):
-                idx = lookup.get(int(k))
-                if idx is not None:
-                    fn[r], ft[r] = c.fn[idx], c.force[idx, :d] * self.rec_sign[r]
+            rec, row = self._recorded_rows()
+            fn[rec], ft[rec] = c.fn[row], c.force[row, :d] * self.rec_sign[rec, None]
         spin = None
         if self.rotation_on:
             spin = self.w.take(g, 0)[:, 2:] if d == 2 else self.w.take(g, 0)
@@ -480,6 +562,8 @@ class Simulation:
         return self.recording(steps, time.perf_counter() - t0)
 
 
+_ZERO = np.zeros(())  # numpy compares with a 0-d array faster than with the float 0.0
+
 # Component k of a x b is a[k+1] b[k+2] - a[k+2] b[k+1] (indices mod 3).
 _NEXT, _AFTER_NEXT = np.array([1, 2, 0]), np.array([2, 0, 1])
 
@@ -492,17 +576,15 @@ def _cross(a, b):
 
 def _all_finite(a):
     """np.isfinite(a).all(), faster on a few grains."""
-    return np.count_nonzero(np.isfinite(a)) == a.size
+    return _count_nonzero(np.isfinite(a)) == a.size
 
 
-def _scatter(idx, values, n):
-    """Sum the rows of `values` (K, 3) into n rows by index, in the rows' order from zero
-    (np.add.at; np.bincount, which adds in the same order, is faster for many rows)."""
-    if len(idx) <= SCATTER_ADD_AT_MAX:
-        out = np.zeros((n, 3))
-        np.add.at(out, idx, values)
-        return out
-    flat = (idx[:, None] * 3 + np.arange(3)).ravel()
+def _scatter(flat, values, n):
+    """Sum the rows of `values` (K, 3) into n rows, component k of row r going to flat
+    place flat[3r + k], in the rows' order from zero (np.bincount adds in that order,
+    as np.add.at does, and is faster even on a few rows)."""
+    if not len(flat):
+        return np.zeros((n, 3))  # (np.bincount would give integers)
     return np.bincount(flat, values.ravel(), 3 * n).reshape(n, 3)
 
 
