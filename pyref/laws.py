@@ -15,6 +15,14 @@ from typing import NamedTuple
 
 import numpy as np
 
+# np.einsum without `optimize` is exactly this C function behind a Python wrapper and the
+# array-function dispatch, which cost more than the sum itself on a few rows (a small
+# scene's step is numpy's per-call overhead): same arithmetic, called directly.
+try:
+    from numpy._core.multiarray import c_einsum as _einsum
+except ImportError:  # numpy < 2
+    from numpy.core.multiarray import c_einsum as _einsum
+
 LAWS = ("stick_slip", "visco_elastic", "visco_plastic", "coulomb")
 RESETS = ("spring", "total")
 SLIP_TIMINGS = ("step", "exact")
@@ -119,12 +127,12 @@ def normal_force(delta, v_n, p: LawParams):
 def rotate_history(D, n):
     """Turn the spring elongation into the current tangent plane, keeping its length
     (the 3D form; when D already lies in the plane, as in 2D on a fixed wall, nothing moves)."""
-    dn = np.einsum("ij,ij->i", D, n)
+    dn = _dot(D, n)
     if not _any(dn):
         return D
-    old = np.einsum("ij,ij->i", D, D)
+    old = _dot(D, D)
     D = D - dn[:, None] * n
-    new = np.einsum("ij,ij->i", D, D)
+    new = _dot(D, D)
     scale = np.sqrt(old / np.maximum(new, 1e-300))
     return D * np.where(new > 0, scale, 1.0)[:, None]
 
@@ -320,7 +328,7 @@ def _plastic_flow(F, u, k_rest, T):
 
 
 def _dot(a, b):
-    return np.einsum("ij,ij->i", a, b)
+    return _einsum("ij,ij->i", a, b)
 
 
 def _any(a):
