@@ -170,7 +170,7 @@ def tangential_force(D, V_s, fn, dt, p: LawParams, energy=False) -> TangentialSt
         F_0 = -p.ks * D_start - p.nu_s * V_s
         slip = slip | (_dot(F_0, F_0) >= limit * limit)
         F_s, stick_share = F_t, np.ones(len(fn))
-        k = np.flatnonzero(slip)
+        k = slip.nonzero()[0]  # (flatnonzero: the same, through two more Python calls)
         if len(k):
             F_s, D = F_t.copy(), D.copy()
             F_s[k], D[k], stick_share[k] = _exact_slips(D_start[k], V_s[k], fn[k], dt, p, mu_s, mu_k)
@@ -236,7 +236,7 @@ def _exact_slips(D0, V_s, fn, dt, p, mu_s, mu_k):
         active[i] = False
 
     while _any(active):
-        a = np.flatnonzero(active)
+        a = active.nonzero()[0]
         # E2. Next slip: the first theta at which |F| reaches T. Before the step's first
         # slip the force may already be at or above T (Fn fell, or V_s jumped): slip now.
         f = _dot(F[a], u[a])

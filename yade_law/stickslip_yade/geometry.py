@@ -172,7 +172,9 @@ def velocities(lay, geo, V, W, rotation, cell, shift):
     facets, boxes may turn anyway)."""
     i1, i2, n, delta = lay.i1, lay.i2, geo["n"], geo["delta"]
     v_rel = V.take(i1, 0) - V.take(i2, 0)
-    vo = None if lay.all_pairs else v_rel.take(lay.other, 0)  # (a copy)
+    spins = np.count_nonzero(W)  # (none in a scene with rotation locked and walls still: no "other" terms)
+    # the "other" rows before the sphere pairs' term is added to every row (a copy), to be put back
+    vo = None if lay.all_pairs or not (spins or (rotation and lay.pairs)) else v_rel.take(lay.other, 0)
     if rotation and lay.pairs:  # w1 x a1 - w2 x a2 = (c1 w1 + c2 w2) x n for sphere pairs
         # lever arms c = r - delta/2 to the contact point midway in the overlap (docs/law.md)
         half = 0.5 * delta[:, None]
@@ -180,7 +182,7 @@ def velocities(lay, geo, V, W, rotation, cell, shift):
         turned = True  # (v_rel's "other" rows are to be put back)
     else:
         turned = False
-    if vo is not None:  # lever arms to the points that meet; walls and facets may turn
+    if vo is not None and spins:  # lever arms to the points that meet; walls and facets may turn
         for side, o, sphere, any_, all_, sign in ((0, lay.o1, lay.s1, lay.s1_any, lay.s1_all, 1.0),
                                                   (1, lay.o2, lay.s2, lay.s2_any, lay.s2_all, -1.0)):
             if rotation or not any_:
@@ -192,8 +194,8 @@ def velocities(lay, geo, V, W, rotation, cell, shift):
             if np.count_nonzero(w):
                 vo += sign * cross(w, arms(lay, geo)[side])
                 turned = True
-        if turned:
-            v_rel.put(lay.other3, vo)
+    if turned and vo is not None:
+        v_rel.put(lay.other3, vo)
     sv = None
     if shift is not None:
         sv = cell @ shift[1].T
@@ -216,7 +218,7 @@ def sphere_pair_fn(lay, geo, kn, cn, v_n, sv):
         # the force applied); V_s uses the true relative velocity (measured: the
         # overlap grows at 1.99e-4 m/s where YADE's dashpot sees -1.80e-3 m/s).
         v_fn = v_n + 2.0 * dot(sv, n)
-    fn = np.maximum(0.0, kn * delta + cn * v_fn)
+    fn = np.maximum(lay.zero, kn * delta + cn * v_fn)  # (0.0 as an array: cheaper, the same values)
     if lay.all_pairs:
         return fn
     out = geo["fn"]
