@@ -27,11 +27,17 @@ SLIP_TIMINGS = ("step", "exact")
 SETTLED = 1e-8
 MAX_EXPLICIT_SLIPS = 100
 
-try:  # numpy's C einsum and count_nonzero themselves: on a few rows their Python layers
-    # (np.einsum, np.count_nonzero) cost as much again as the work, or ten times as much
+# numpy's C einsum and count_nonzero themselves. np.einsum without `optimize` is exactly
+# c_einsum behind a Python wrapper and the array-function dispatch; on a few rows those
+# layers cost as much again as the work (np.count_nonzero's ten times as much), and a small
+# scene's step is numpy's per-call overhead: same arithmetic, called directly.
+try:  # numpy 2 (the project's venv)
     from numpy._core.multiarray import c_einsum as _einsum, count_nonzero as _count_nonzero
-except ImportError:  # numpy < 2
-    _einsum, _count_nonzero = np.einsum, np.count_nonzero
+except ImportError:
+    try:  # numpy 1 (Debian's python3-numpy, which YADE runs the law with)
+        from numpy.core.multiarray import c_einsum as _einsum, count_nonzero as _count_nonzero
+    except ImportError:
+        _einsum, _count_nonzero = np.einsum, np.count_nonzero
 
 
 @dataclass

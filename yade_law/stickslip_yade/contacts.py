@@ -103,11 +103,13 @@ class ContactSet:
         lay = self.index(bodies)
         ss, other, pairs = lay.ss, lay.other, lay.pairs
         d, dist, delta = geometry.sphere_pairs(P, lay, self.cell, shift)
-        if pairs and (np.abs(delta) <= lay.band if lay.all_pairs else (np.abs(delta) <= lay.band)[ss]).any():
+        # (the common step: no sphere pair broken nor near touching, one test for both)
+        near = pairs and np.count_nonzero(delta <= lay.band_ss)
+        if near and np.count_nonzero(np.abs(delta) <= lay.band_ss):
             return None
         g = geometry.with_walls(O, self.wrappers, lay.keys_other, P, lay, shift, self.cell)
         n_alive, broken = len(keys), None
-        if (pairs and (delta if lay.all_pairs else delta[ss]).min() < 0) or g["broken"].any():
+        if (near and np.count_nonzero((delta < 0.0) & ss)) or g["nbroken"]:
             broken = delta < 0  # Law2_ScGeom_ViscElPhys_Basic drops a contact when its overlap < 0
             if len(other):
                 broken &= ss
@@ -122,7 +124,7 @@ class ContactSet:
             alive = ~broken
             remap = np.cumsum(alive) - 1
             kept = ~g["broken"]
-            g = {k: v[kept] for k, v in g.items()}
+            g = {k: v[kept] for k, v in g.items() if k != "nbroken"}
             d, dist, delta = d[alive], dist[alive], delta[alive]
             self.take(alive, keyset_updated=True)
             lay = self.index(bodies)  # (its other rows: those of g)
@@ -185,7 +187,7 @@ class ContactSet:
             self.wrappers[int(self.keys[j])] = L[old[j]]
         d, dist, delta = geometry.sphere_pairs(P, lay, self.cell, shift)
         g = geometry.with_walls(O, self.wrappers, lay.keys_other, P, lay, shift, self.cell)
-        if g["broken"].any():
+        if g["nbroken"]:
             fail("internal: a real interaction has no geometry")
         geo = geometry.assemble(lay, d, dist, delta, g)
         return self._add(O, bodies, P, shift, geo, keys[new], [L[j] for j in new.tolist()], made[new], None)
@@ -213,7 +215,7 @@ class ContactSet:
         i1, i2, ss = lay.i1, lay.i2, lay.ss
         d, dist, delta = geometry.sphere_pairs(P, lay, cell, shift)
         g = geometry.with_walls(O, self.wrappers, lay.keys_other, P, lay, shift, cell)
-        if g["broken"].any():
+        if g["nbroken"]:
             fail("internal: a new real interaction has no geometry")
         new = geometry.assemble(lay, d, dist, delta, g)
         if (ss & (dist == 0)).any():

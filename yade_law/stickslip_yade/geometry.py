@@ -7,6 +7,12 @@ Sphere pairs are recomputed in numpy from the bodies' positions (lever arms r - 
 to the contact point midway in the overlap); contacts with a wall, facet or box take YADE's
 normal, overlap and normal force, read one by one, and the wall's side of the contact is
 the point of its surface nearest the sphere's centre.
+
+On a scene of a few contacts a step costs numpy's per-call overhead, not arithmetic, so
+rows are gathered with `take` (2D fancy indexing costs four times more), scattered with
+`put` on flat indices, and tests are `count_nonzero` of a comparison rather than
+`any`/`min`, which are reductions (2-3 us each whatever the size); the arithmetic is the
+same, bit for bit.
 """
 import numpy as np
 
@@ -32,10 +38,15 @@ class Layout:
         self.r1, self.r2 = radius[i1], radius[i2]
         self.rsum = self.r1 + self.r2
         self.band = self.TOUCH_BAND * self.rsum
+        # delta <= band_ss somewhere: a sphere pair is broken (delta < 0) or within the band
+        # (other rows: -1, never); one test of the common step for both (contacts.py)
+        self.band_ss = np.where(self.ss, self.band, -1.0)
+        self.zero = np.zeros(self.n)  # (comparing with an array is cheaper than with 0.0)
         self.pairs = len(self.other) < self.n  # any sphere pair
         self.all_pairs = not len(self.other)
         o = self.other
         self.keys_other = keys[o]
+        self.other3 = (3 * o[:, None] + np.arange(3)).ravel()  # flat indices of their (K, 3) rows
         self.o1, self.o2, self.or1, self.or2 = i1[o], i2[o], self.r1[o], self.r2[o]
         self.s1, self.s2 = sphere[self.o1], sphere[self.o2]  # which side of an "other" contact is the sphere
         self.s1_any, self.s1_all = bool(self.s1.any()), bool(self.s1.all())
@@ -57,7 +68,7 @@ def sphere_pairs(P, lay, cell, shift):
     if not lay.pairs:
         z = np.zeros(lay.n)
         return np.zeros((lay.n, 3)), z, z.copy()
-    d = P[lay.i2] - P[lay.i1]
+    d = P.take(lay.i2, 0) - P.take(lay.i1, 0)
     if shift is not None:
         d += cell @ shift[0].T
     dist = np.sqrt(dot(d, d))
@@ -73,8 +84,8 @@ def with_walls(O, wrappers, keys, P, lay, shift, cell):
     m = len(keys)
     broken = np.zeros(m, bool)
     if not m:
-        return {"broken": broken}
-    rows = []
+        return {"broken": broken, "nbroken": 0}
+    rows, nbroken = [], 0
     for j, k in enumerate(keys.tolist()):
         I = wrappers.get(k)
         if I is None:
@@ -82,15 +93,17 @@ def with_walls(O, wrappers, keys, P, lay, shift, cell):
         g = I.geom
         if g is None:
             broken[j] = True
+            nbroken += 1
             wrappers.pop(k, None)
             rows.append((0.0,) * 5)
         else:
             rows.append(g.normal.__getinitargs__() + (g.penetrationDepth, I.phys.normalForce.norm()))
     A = np.array(rows).reshape(m, 5)
-    x2 = P[lay.o2]
+    x2 = P.take(lay.o2, 0)
     if shift is not None:
         x2 = x2 + cell[lay.other] @ shift[0].T
-    return {"broken": broken, "n": A[:, 0:3], "delta": A[:, 3], "fn": A[:, 4], "x1": P[lay.o1], "x2": x2}
+    return {"broken": broken, "nbroken": nbroken, "n": A[:, 0:3], "delta": A[:, 3], "fn": A[:, 4],
+            "x1": P.take(lay.o1, 0), "x2": x2}
 
 
 def arms(lay, geo):
@@ -135,10 +148,12 @@ def assemble(lay, d, dist, delta, g):
     elif not lay.pairs:  # walls, facets, boxes only
         return {"i1": lay.i1, "i2": lay.i2, "ss": lay.ss, "n": g["n"], "delta": g["delta"], "fn": g["fn"],
                 "other": other, "no": g["n"], "do": g["delta"], "x1o": g["x1"], "x2o": g["x2"]}
-    n = d / (dist if len(dist) and dist.min() > 0 else np.where(dist > 0, dist, 1.0))[:, None]
+    positive = dist > lay.zero
+    n = d / (dist if np.count_nonzero(positive) == len(dist) else np.where(positive, dist, 1.0))[:, None]
     fn = np.zeros(lay.n)
     if len(other):
-        n[other], delta[other], fn[other] = g["n"], g["delta"], g["fn"]
+        n.put(lay.other3, g["n"])
+        delta[other], fn[other] = g["delta"], g["fn"]
     return {"i1": lay.i1, "i2": lay.i2, "ss": lay.ss, "n": n, "delta": delta, "fn": fn, "other": other,
             "no": g["n"], "do": g["delta"], "x1o": g["x1"], "x2o": g["x2"]}
 
@@ -150,35 +165,37 @@ def join(geo, new):
     return out
 
 
-def velocities(lay, geo, V, W, radius, rotation, cell, shift):
+def velocities(lay, geo, V, W, rotation, cell, shift):
     """Relative velocity of id1's contact point w.r.t. id2's (docs/law.md step 1; across a
     periodic boundary id2's image also moves with the cell): (v_n, V_s (eq. 6), the cell's
     shift velocity or None). Without rotation the spheres' spins are left out (walls,
     facets, boxes may turn anyway)."""
     i1, i2, n, delta = lay.i1, lay.i2, geo["n"], geo["delta"]
-    v_rel = V[i1] - V[i2]
-    vo = None if lay.all_pairs else v_rel[lay.other]  # (a copy)
+    v_rel = V.take(i1, 0) - V.take(i2, 0)
+    spins = np.count_nonzero(W)  # (none in a scene with rotation locked and walls still: no "other" terms)
+    # the "other" rows before the sphere pairs' term is added to every row (a copy), to be put back
+    vo = None if lay.all_pairs or not (spins or (rotation and lay.pairs)) else v_rel.take(lay.other, 0)
     if rotation and lay.pairs:  # w1 x a1 - w2 x a2 = (c1 w1 + c2 w2) x n for sphere pairs
         # lever arms c = r - delta/2 to the contact point midway in the overlap (docs/law.md)
         half = 0.5 * delta[:, None]
-        v_rel += cross((radius[i1][:, None] - half) * W[i1] + (radius[i2][:, None] - half) * W[i2], n)
+        v_rel += cross((lay.r1[:, None] - half) * W.take(i1, 0) + (lay.r2[:, None] - half) * W.take(i2, 0), n)
         turned = True  # (v_rel's "other" rows are to be put back)
     else:
         turned = False
-    if vo is not None:  # lever arms to the points that meet; walls and facets may turn
+    if vo is not None and spins:  # lever arms to the points that meet; walls and facets may turn
         for side, o, sphere, any_, all_, sign in ((0, lay.o1, lay.s1, lay.s1_any, lay.s1_all, 1.0),
                                                   (1, lay.o2, lay.s2, lay.s2_any, lay.s2_all, -1.0)):
             if rotation or not any_:
-                w = W[o]
+                w = W.take(o, 0)
             elif all_:
                 continue  # (a sphere's spin is left out: no term)
             else:
-                w = np.where(sphere[:, None], 0.0, W[o])
-            if w.any():
+                w = np.where(sphere[:, None], 0.0, W.take(o, 0))
+            if np.count_nonzero(w):
                 vo += sign * cross(w, arms(lay, geo)[side])
                 turned = True
-        if turned:
-            v_rel[lay.other] = vo
+    if turned and vo is not None:
+        v_rel.put(lay.other3, vo)
     sv = None
     if shift is not None:
         sv = cell @ shift[1].T
@@ -201,11 +218,11 @@ def sphere_pair_fn(lay, geo, kn, cn, v_n, sv):
         # the force applied); V_s uses the true relative velocity (measured: the
         # overlap grows at 1.99e-4 m/s where YADE's dashpot sees -1.80e-3 m/s).
         v_fn = v_n + 2.0 * dot(sv, n)
-    fn = np.maximum(0.0, kn * delta + cn * v_fn)
+    fn = np.maximum(lay.zero, kn * delta + cn * v_fn)  # (0.0 as an array: cheaper, the same values)
     if lay.all_pairs:
         return fn
     out = geo["fn"]
-    out[lay.ss] = fn[lay.ss]
+    np.copyto(out, fn, where=lay.ss)
     return out
 
 

@@ -26,6 +26,19 @@ def cross(a, b):
     return c
 
 
+def finite_sum(x):
+    """True if the sum of x's values is finite (it is only if all of them are), as a dot
+    product with ones: numpy's sum is a reduction, 2-3 us on a few values."""
+    global _ONES
+    x = x.ravel()
+    if len(_ONES) < len(x):
+        _ONES = np.ones(2 * len(x))
+    return math.isfinite(x.dot(_ONES[:len(x)]))
+
+
+_ONES = np.ones(64)  # for finite_sum
+
+
 class Bodies:
     """Per-body data that does not change during a run: which ids exist, which bodies are
     spheres, their radii, the shapes present (the first body of each)."""
@@ -86,7 +99,7 @@ class Bodies:
         else:
             P, V, W = np.zeros((nb, 3)), np.zeros((nb, 3)), np.zeros((nb, 3))
             P[self.ids], V[self.ids], W[self.ids] = A[:, 0:3], A[:, 3:6], A[:, 6:9]
-        if not math.isfinite(A.sum()):  # (one reduction; the culprit is looked for only if needed)
+        if not finite_sum(A):  # (the culprit is looked for only if needed)
             finite_bodies(it, P, V, W)
         return P, V, W
 

@@ -16,7 +16,7 @@ from . import checkpoints, checks, contacts, energy, geometry
 from .checks import LawError
 from .contacts import ContactSet, key
 from .kernel import LawParams, rotate_history, tangential_force
-from .kinematics import Bodies, cell_motion, cross
+from .kinematics import Bodies, cell_motion, cross, finite_sum
 
 
 class StickSlipLaw:
@@ -44,6 +44,7 @@ class StickSlipLaw:
         self.min_dissipation = 0.0
         self.error = None  # the message of the error that stopped the run, if any
         self.setup_step = False  # True: the next step loads no spring (verlet_start.py)
+        self.n_slipped = 0  # contacts that slipped in the last step
         self.contacts = ContactSet()
         self.bodies = None  # kinematics.Bodies of the scene, None: to be read
         # Checkpoints: the scene the state belongs to, the iteration of the law's last step
@@ -103,12 +104,13 @@ class StickSlipLaw:
             contacts.same_as_yade(O, c.keys)
             self.set_checks += 1
         if len(c.keys) == 0:
+            self.n_slipped = 0
             if O.trackEnergy:
                 energy.book(O, 0.0, 0.0, 0.0, 0.0, 0.0)
             return
         lay = c.index(bodies)  # (the rows of geo)
         i1, i2, n, delta, fn = lay.i1, lay.i2, geo["n"], geo["delta"], geo["fn"]
-        v_n, V_s, sv = geometry.velocities(lay, geo, V, W, bodies.radius, self.rotation, c.cell, shift)
+        v_n, V_s, sv = geometry.velocities(lay, geo, V, W, self.rotation, c.cell, shift)
         if lay.pairs:
             fn = geometry.sphere_pair_fn(lay, geo, c.kn, c.cn, v_n, sv)
         if self.check:
@@ -121,16 +123,18 @@ class StickSlipLaw:
         book = O.trackEnergy
         tan = tangential_force(rotate_history(c.D, n), V_s, fn, dt, self.params, energy=book)
         F_s = tan.force
-        apart = delta <= 0
-        if apart.any():  # YADE's real interactions include spheres touching a wall or facet at zero
+        apart = delta <= lay.zero
+        if np.count_nonzero(apart):  # YADE's real interactions include spheres touching a wall or facet at zero
             # overlap; for the law that is no contact yet (docs/law.md step 3): no force, no spring
             F_s[apart], tan.spring[apart], tan.slipped[apart] = 0.0, 0.0, False
             if book:
                 tan.dissipated_dashpot[apart] = tan.dissipated_slip[apart] = 0.0
-        if not math.isfinite(fn.sum() + F_s.sum()):  # (a sum is finite only if all its terms are)
+        if not (finite_sum(fn) and finite_sum(F_s)):
             checks.finite_forces(it, i1, i2, fn, F_s)
         c.D, c.fn, c.F_s, c.slipped = tan.spring, fn, F_s, tan.slipped
-        c.count = c.count + tan.slipped
+        self.n_slipped = np.count_nonzero(tan.slipped)
+        if self.n_slipped:
+            c.count = c.count + tan.slipped
         if book:
             self.min_dissipation = min(self.min_dissipation,
                                        energy.book_step(O, tan, self.ks, c.kn, delta, fn, v_n, dt))
@@ -139,31 +143,27 @@ class StickSlipLaw:
     def _apply(self, O, lay, geo, F_s):
         """Forces and torques summed per body (in contact order: one bincount over the flat
         components), then one addF (and addT) per body that gets any."""
-        i1, i2, n, delta, other = lay.i1, lay.i2, geo["n"], geo["delta"], lay.other
+        n, delta, other = geo["n"], geo["delta"], lay.other
         nb = self.bodies.n
         f1, f2 = lay.flat()
         flat = F_s.ravel()
         F = (np.bincount(f1, flat, 3 * nb) - np.bincount(f2, flat, 3 * nb)).reshape(nb, 3)
         if not self.rotation:
-            got = np.flatnonzero(F.any(axis=1))
-            list(map(O.forces.addF, got.tolist(), F[got].tolist(), repeat(False)))
+            ids, F = nonzero_rows(F)
+            list(map(O.forces.addF, ids, F, repeat(False)))
             return
         # Torques a1 x F_s on id1 and a2 x (-F_s) on id2; for sphere pairs c1 (n x F_s), c2 (n x F_s),
         # c = r - delta/2 (docs/law.md step 6).
-        radius = self.bodies.radius
         nF = cross(n, F_s)
-        t1 = (radius[i1] - 0.5 * delta)[:, None] * nF
-        t2 = (radius[i2] - 0.5 * delta)[:, None] * nF
+        t1 = (lay.r1 - 0.5 * delta)[:, None] * nF
+        t2 = (lay.r2 - 0.5 * delta)[:, None] * nF
         if len(other):
             a1, a2 = geometry.arms(lay, geo)
-            t1[other] = cross(a1, F_s[other])
-            t2[other] = -cross(a2, F_s[other])
+            Fo = F_s.take(other, 0)
+            t1.put(lay.other3, cross(a1, Fo))
+            t2.put(lay.other3, -cross(a2, Fo))
         T = (np.bincount(f1, t1.ravel(), 3 * nb) + np.bincount(f2, t2.ravel(), 3 * nb)).reshape(nb, 3)
-        got = np.flatnonzero(F.any(axis=1) | T.any(axis=1))
-        if len(got) == nb:  # every body: no copies
-            ids, F, T = range(nb), F.tolist(), T.tolist()
-        else:
-            ids, F, T = got.tolist(), F[got].tolist(), T[got].tolist()
+        ids, F, T = nonzero_rows(F, T)
         # (permanent=False given: boost.python then skips filling the default, 15 % faster)
         list(map(O.forces.addF, ids, F, repeat(False)))
         list(map(O.forces.addT, ids, T, repeat(False)))
@@ -203,3 +203,31 @@ class StickSlipLaw:
 
     def n_contacts(self):
         return len(self.contacts.keys)
+
+
+# Up to this many bodies the per-body lists are filtered in plain Python: numpy's
+# any/flatnonzero/fancy indexing cost 2-3 us each whatever the size.
+FEW = 64
+
+
+def nonzero_rows(F, T=None):
+    """(ids, F rows, T rows) as lists, of the bodies whose F (or T) has a non-zero component
+    (NaN counts, as in numpy's any); bodies with neither get no addF/addT call."""
+    nb = len(F)
+    if nb <= FEW:
+        Fl = F.tolist()
+        if T is None:
+            got = [i for i in range(nb) if any(Fl[i])]
+            return got, [Fl[i] for i in got]
+        Tl = T.tolist()
+        got = [i for i in range(nb) if any(Fl[i]) or any(Tl[i])]
+        if len(got) == nb:
+            return got, Fl, Tl
+        return got, [Fl[i] for i in got], [Tl[i] for i in got]
+    if T is None:
+        got = np.flatnonzero(F.any(axis=1))
+        return got.tolist(), F.take(got, 0).tolist()
+    got = np.flatnonzero(F.any(axis=1) | T.any(axis=1))
+    if len(got) == nb:  # every body: no copies
+        return range(nb), F.tolist(), T.tolist()
+    return got.tolist(), F.take(got, 0).tolist(), T.take(got, 0).tolist()
