@@ -312,9 +312,10 @@ def report_section(report_dir, docs=DOCS):
                                   "resumable): `.venv/bin/stickslip drum-study`; it writes docs/drum/ (the findings: "
                                   "docs/drum.md).", ""])
     rel = os.path.relpath(docs, report_dir)
+    findings = os.path.relpath(docs.parent / "drum.md", report_dir)
     study = pd.read_csv(docs / "study.csv")
     lines += [f"From the finished study in [{rel}/study.md]({rel}/study.md) ({len(study)} runs; the findings and the "
-              f"calibration recipe: [{rel}/../drum.md]({rel}/../drum.md)). Means ± standard errors, degrees.", "",
+              f"calibration recipe: [{findings}]({findings})). Means ± standard errors, degrees.", "",
               "| run | avalanches | θ_start (fit) | θ_stop (fit) | θ_start (centroid) | θ_stop (centroid) |",
               "|---|---|---|---|---|---|"]
     for _, r in study.iterrows():
