@@ -24,9 +24,9 @@ import numpy as np
 import pandas as pd
 
 from . import runner
-from .drum_study import load_run, run_one
+from .drum_study import check_duration, load_run, run_one
 from .kinds import drum
-from .scene import find, load
+from .scene import find, load, parse
 
 COST_DURATION = 1.0  # s: the fill falls (0.2 s) and sits as a pile of ~360 contacts
 DIVERGENCE_DURATION = 0.4  # s: round-off grows to the grains' size well before (measured)
@@ -123,12 +123,12 @@ def statistics(out, out_runs, engines, duration, progress=True):
     """The drum run for `duration` s on each engine (kept in out_runs/engines_<engine>,
     resumed like the study's runs); their avalanche means side by side, and each mean's
     difference from the first engine's in units of the two standard errors combined."""
-    path = find("drum")
-    sc = load("drum", duration=duration)
     import tomllib
 
-    data = tomllib.loads(path.read_text())
+    path = find("drum")
+    data = tomllib.loads(path.read_text())  # the scene's data, kept with each run to tell it apart
     data["time"]["duration"] = duration
+    sc = parse(data, source=path)
     rows = []
     for engine in engines:
         folder = Path(out_runs) / f"engines_{engine}"
@@ -159,9 +159,8 @@ def run(out, out_runs, engines, duration, parts, progress=True):
     if missing:
         e, why = next(iter(missing.items()))
         raise SceneError(f"--engines {e}: not available ({why})")
-    if "statistics" in parts and duration <= load("drum").analysis["settle"] + 5:
-        raise SceneError(f"--duration {duration:g}: must be > {load('drum').analysis['settle'] + 5:g} s "
-                         "(the first seconds settle)")
+    if "statistics" in parts:
+        check_duration(duration, load("drum").analysis["settle"])
     say = sys.stderr.write
     if "costs" in parts:
         say(f"drum-engines: costs, the drum's first {COST_DURATION} s on {', '.join(engines)} (~1-2 min)\n")
