@@ -1,0 +1,39 @@
+"""The law's contract on every engine (tests/law_contract.py): one-contact cases with
+exact numbers, each engine's record compared to hand-worked values to the ulp."""
+import numpy as np
+import pytest
+
+import contract_runners as runners
+import law_contract as lc
+from stickslip.adapters import ENGINES
+
+
+@pytest.mark.parametrize("engine", sorted(runners.RUNNERS))
+@pytest.mark.parametrize("case", lc.CASES, ids=lambda c: c.name)
+def test_contract(case, engine):
+    why = runners.available(engine)
+    if why:
+        pytest.skip(f"engine missing: {engine}: {why}")
+    lc.compare(case, runners.RUNNERS[engine](case))
+
+
+def test_every_engine_has_the_contract():
+    """An engine added to stickslip.adapters.ENGINES must bring its contract runner (or
+    say whose kernel it runs)."""
+    missing = set(ENGINES) - set(runners.RUNNERS) - set(runners.SHARED_KERNEL)
+    assert not missing, f"engines without a contract runner in tests/contract_runners.py: {sorted(missing)}"
+    undecided = set(runners.RUNNERS) - set(runners.TYPE_PAIR_RUNNERS) - set(runners.NO_TYPE_PAIRS)
+    assert not undecided, f"engines with neither a per-type-pair runner nor a reason: {sorted(undecided)}"
+
+
+@pytest.mark.parametrize("engine", sorted(runners.TYPE_PAIR_RUNNERS))
+def test_coefficients_per_type_pair(engine):
+    """mu_s and mu_k read for the contact's own pair of types: every pair different."""
+    why = runners.available(engine)
+    if why:
+        pytest.skip(f"engine missing: {engine}: {why}")
+    traces = runners.TYPE_PAIR_RUNNERS[engine]()
+    assert set(traces) == set(lc.TYPE_PAIRS) - {(1, 1)}
+    for pair, trace in traces.items():
+        w = lc.X * (np.array([1.0, 0, 0]) if 1 in pair else np.array([0, 1.0, 0]))
+        lc.compare_type_pair(pair, trace, w)
