@@ -19,6 +19,78 @@ def pytest_addoption(parser):
     parser.addoption("--runslow", action="store_true", help="also run the long opt-in tests")
 
 
+# ---------------------------------------------------------------- engines the tests need
+# Every test that needs an engine (stickslip.adapters.ENGINES, each adapter's available())
+# or a package beside it skips through needs_engine / skip_engine, whose reasons start with
+# ENGINE_SKIP. As root (./run.sh test installs every engine then; CI runs as root) a missing
+# engine stops the run at once with one line naming it; otherwise the run's last line counts
+# the engine tests it skipped.
+ENGINE_SKIP = "engine missing"
+
+
+def as_root():
+    return hasattr(os, "geteuid") and os.geteuid() == 0
+
+
+def engine_missing(name):
+    """None if the engine can run here, else why not (its adapter's word)."""
+    from stickslip import adapters
+
+    return adapters.get(name).available()
+
+
+def needs_engine(name):
+    """A mark (pytestmark, or on a test): skip when the engine cannot run here."""
+    why = engine_missing(name)
+    return pytest.mark.skipif(why is not None, reason=f"{ENGINE_SKIP}: {name}: {why}")
+
+
+def skip_engine(name, why=None):
+    """Inside a test: skip when the engine (or `why`, a package it needs) is missing; as
+    root that is a failure, not a skip."""
+    why = why or engine_missing(name)
+    if why is None:
+        return
+    if as_root():
+        pytest.fail(f"{name}: {why} (root runs need every engine: ./run.sh setup installs them)", pytrace=False)
+    pytest.skip(f"{ENGINE_SKIP}: {name}: {why}")
+
+
+def pytest_configure(config):
+    if hasattr(config, "workerinput") or not as_root():  # (xdist workers: the controller checks)
+        return
+    from stickslip import adapters
+
+    _, missing = adapters.available()
+    if missing:
+        raise pytest.UsageError("engines missing on a root run (CI needs them all): "
+                                + "; ".join(f"{e}: {why}" for e, why in missing.items()))
+
+
+_engine_skips = {}  # engine -> number of tests skipped for it (reports reach the xdist controller)
+
+
+def pytest_runtest_logreport(report):
+    if report.skipped and isinstance(report.longrepr, tuple):
+        reason = str(report.longrepr[2])
+        if ENGINE_SKIP + ":" in reason:
+            engine = reason.split(ENGINE_SKIP + ":", 1)[1].split(":", 1)[0].strip()
+            _engine_skips[engine] = _engine_skips.get(engine, 0) + 1
+
+
+@pytest.hookimpl(hookwrapper=True, tryfirst=True)
+def pytest_sessionfinish(session):
+    yield  # (outermost: after pytest's own summary line, so this is the run's last line)
+    if _engine_skips and not hasattr(session.config, "workerinput"):
+        tr = session.config.pluginmanager.get_plugin("terminalreporter")
+        text = ", ".join(f"{e} {n}" for e, n in sorted(_engine_skips.items()))
+        line = f"engine tests skipped: {sum(_engine_skips.values())} ({text}); as root they would fail"
+        if tr is not None:
+            tr.write_line(line)
+        else:
+            print(line)
+
+
 def pytest_collection_modifyitems(config, items):
     if config.getoption("--runslow"):
         return

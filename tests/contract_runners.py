@@ -295,10 +295,3 @@ RUNNERS = {"pyref": run_pyref, "liggghts": run_liggghts}
 TYPE_PAIR_RUNNERS = {"liggghts": run_liggghts_type_pairs}
 NO_TYPE_PAIRS = {"pyref": "one material per scene: one mu_s, mu_k for every contact"}
 
-
-def available(engine):
-    """None if the engine can run the contract here, else why not (its adapter's word)."""
-    from stickslip import adapters
-
-    return adapters.get(engine).available()
-

@@ -154,6 +154,14 @@ def _cases():
         cases.append(Case(f"slip_inside_step_exact_timing_{label}", "E2-E3, E7: the slip at its time inside the step",
                           "wall", (Segment(n, ALONG_X),), 24.25 * X, 18.125 * X, nu_s=nu_s, reset=reset,
                           timing="exact"))
+    # Exact timing, a step that starts at the threshold (E0, E2: "at once"): 18 steps load
+    # the spring to 18 (T = 24, Fn = 1), then Fn falls to 3/4 (T = 18: the trial force is
+    # at it) and the grain turns back: the trial force would fall to 17 by the step's end
+    # (the step timing sees no slip), but it slips at theta = 0 to Fmin = 9 along its
+    # direction, then unloads by 1 a step: 8, 7, 6 (the spring, -x of the force, follows).
+    cases.append(Case("slip_at_step_start_exact_timing", "E0, E2: |F_0| >= mu_s Fn slips at once",
+                      "wall", (Segment(18, ALONG_X), Segment(3, (-0.25, 0.0, 0.0), delta=3.0 / 128)),
+                      24 * X, 18 * X, timing="exact"))
     # Fn = 0 (step 2: never tensile). kn delta + nu_n v_n with v_n = -1/2 (grain leaving):
     # nu_n = 2 gives 1 - 1 = 0 exactly, nu_n = 4 gives -1, clipped to 0. No friction:
     # every step slips (0 >= 0), force 0, spring reset: 0 (spring) or -nu_s V/Ks (total:
@@ -211,6 +219,9 @@ def expected(case: Case):
         return sawtooth(1, 0, {20, 32}, 12, 4, "total", n)
     if name.startswith("slip_inside_step"):
         return _inside_step(case)
+    if name == "slip_at_step_start_exact_timing":
+        turned = [Expect(0.75, (f * X, 0.0, 0.0), (f * X, 0.0, 0.0), 1) for f in (8, 7, 6)]
+        return [Expect(1.0, k, k, 0) for k in range(1, 19)] + turned
     if name.startswith("fn_zero"):
         leaving_d = 0.0 if case.reset == "spring" else -4.0  # total: D = -nu_s V/Ks = -4 w
         if name == "fn_zero_no_sliding_still_slips":

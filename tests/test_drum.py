@@ -14,9 +14,9 @@ from stickslip.adapters import liggghts as liggghts_adapter
 from stickslip.cli import main
 from stickslip.kinds import drum
 from pyref import Simulation
+from conftest import needs_engine, skip_engine
 
-needs_liggghts = pytest.mark.skipif(liggghts_adapter.available() is not None,
-                                    reason=str(liggghts_adapter.available()))
+needs_liggghts = needs_engine("liggghts")
 BASE = tomllib.loads(scene_mod.find("drum").read_text())
 
 
@@ -314,8 +314,7 @@ def test_drum_on_yade_is_pyrefs_in_free_fall(tmp_path):
     by the collisions like any (test_drum_on_liggghts_is_pyrefs_step_for_step)."""
     from stickslip.adapters import yade as yade_adapter
 
-    if yade_adapter.available() is not None:
-        pytest.skip(str(yade_adapter.available()))
+    skip_engine("yade")
     sc = scene_mod.load("drum", duration=0.005, every=100)
     dy = yade_adapter.run(sc, tmp_path).timeseries
     dp = columns.frame(sc, Simulation(sc).run())

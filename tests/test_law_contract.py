@@ -5,15 +5,14 @@ import pytest
 
 import contract_runners as runners
 import law_contract as lc
+from conftest import skip_engine
 from stickslip.adapters import ENGINES
 
 
 @pytest.mark.parametrize("engine", sorted(runners.RUNNERS))
 @pytest.mark.parametrize("case", lc.CASES, ids=lambda c: c.name)
 def test_contract(case, engine):
-    why = runners.available(engine)
-    if why:
-        pytest.skip(f"engine missing: {engine}: {why}")
+    skip_engine(engine)
     lc.compare(case, runners.RUNNERS[engine](case))
 
 
@@ -29,9 +28,7 @@ def test_every_engine_has_the_contract():
 @pytest.mark.parametrize("engine", sorted(runners.TYPE_PAIR_RUNNERS))
 def test_coefficients_per_type_pair(engine):
     """mu_s and mu_k read for the contact's own pair of types: every pair different."""
-    why = runners.available(engine)
-    if why:
-        pytest.skip(f"engine missing: {engine}: {why}")
+    skip_engine(engine)
     traces = runners.TYPE_PAIR_RUNNERS[engine]()
     assert set(traces) == set(lc.TYPE_PAIRS) - {(1, 1)}
     for pair, trace in traces.items():

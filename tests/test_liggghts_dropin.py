@@ -27,21 +27,19 @@ import pytest
 
 import liggghts_tutorials as tut
 from stickslip.adapters.liggghts import LAUNCHER
+from conftest import needs_engine, skip_engine
 from test_liggghts_plugin import F17, read_dump, run_liggghts
 
 EPS = np.finfo(float).eps
 
-if not LAUNCHER.is_file():
-    pytest.skip(f"LIGGGHTS plugin not built ({LAUNCHER} missing)", allow_module_level=True)
-if shutil.which("liggghts") is None:
-    pytest.skip("LIGGGHTS is not installed", allow_module_level=True)
+pytestmark = needs_engine("liggghts")
 
 STOCK_RULES = "history_rotation project history_on_separation keep"
 
 
 def needs_tutorial(name):
     if not tut.available(name):
-        pytest.skip(f"LIGGGHTS tutorial {name} not installed (apt-get install liggghts-doc)")
+        skip_engine("liggghts", f"LIGGGHTS tutorial {name} not installed (apt-get install liggghts-doc)")
 
 
 def run_variant(name, work, **kw):
@@ -485,7 +483,7 @@ def library_combinations():
     library builds with `tangential history`, read from its exported symbols."""
     lib = Path("/usr/lib/x86_64-linux-gnu/libliggghts.so.3")
     if shutil.which("nm") is None or not lib.exists():
-        pytest.skip("nm or the LIGGGHTS library not found")
+        skip_engine("liggghts", "nm or the LIGGGHTS library not found")
     text = subprocess.run(["nm", "-DC", "--defined-only", str(lib)], capture_output=True, text=True).stdout
     found = {}
     for kind in ("PairStyles", "Walls"):

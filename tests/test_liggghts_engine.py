@@ -13,10 +13,9 @@ import pytest
 from stickslip import analysis
 from stickslip import scene as scene_mod
 from stickslip.adapters import liggghts as liggghts_adapter
-from conftest import paper_case, run_pyref
+from conftest import needs_engine, paper_case, run_pyref
 
-needs_liggghts = pytest.mark.skipif(liggghts_adapter.available() is not None,
-                                    reason=str(liggghts_adapter.available()))
+needs_liggghts = needs_engine("liggghts")
 EPS = np.finfo(float).eps
 
 

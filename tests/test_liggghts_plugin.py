@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from conftest import needs_engine, skip_engine
 from stickslip.adapters.liggghts import LAUNCHER, PRELOAD
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -34,13 +35,7 @@ TEMPLATES = Path(__file__).resolve().parent / "liggghts"
 STOCK = shutil.which("liggghts")
 EPS = np.finfo(float).eps
 
-if not LAUNCHER.is_file():
-    pytest.skip(f"LIGGGHTS plugin not built ({LAUNCHER} missing): cmake -S liggghts_plugin "
-                "-B build/liggghts_plugin && cmake --build build/liggghts_plugin -j2",
-                allow_module_level=True)
-if STOCK is None:
-    pytest.skip("LIGGGHTS is not installed (`liggghts` not on PATH): apt-get install liggghts "
-                "libliggghts-dev", allow_module_level=True)
+pytestmark = needs_engine("liggghts")  # the plugin built and LIGGGHTS installed (the adapter's check)
 
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
 CRASH_MARKERS = ("Segmentation fault", "segmentation fault", "core dumped", "Traceback",
@@ -731,7 +726,7 @@ def test_stock_liggghts_package_untouched():
     """The plugin builds beside LIGGGHTS: the Debian packages' files are unchanged and
     nothing of the plugin was put into the installed headers."""
     if shutil.which("dpkg") is None:
-        pytest.skip("dpkg not available")
+        skip_engine("liggghts", "dpkg not available")
     proc = subprocess.run(["dpkg", "-V", "liggghts", "libliggghts-dev"], capture_output=True, text=True)
     print(f"\n[dpkg -V liggghts libliggghts-dev] exit {proc.returncode}, output: {proc.stdout!r} {proc.stderr!r}")
     assert proc.returncode == 0 and proc.stdout == "" and proc.stderr == ""

@@ -9,7 +9,7 @@ from stickslip import analysis
 from stickslip import scene as scene_mod
 from stickslip.precision import run_precision
 from stickslip.thresholds import formula, measure
-from conftest import run_pyref
+from conftest import run_pyref, skip_engine
 
 
 @pytest.mark.parametrize("dt,nu_s", [(1e-6, 0.0), (4e-6, 33.1), (1.6e-5, 100.0)])
@@ -60,9 +60,7 @@ def test_precision_reference_engine(tmp_path):
     (relative errors ~1e-5..1e-2, round-off ~1e-13)."""
     from stickslip import adapters
 
-    reason = adapters.get("liggghts").available()
-    if reason is not None:
-        pytest.skip(f"liggghts: {reason}")
+    skip_engine("liggghts")
     factors = (4, 2, 1, 0.5)
     lig, _ = run_precision("drag", ["liggghts"], tmp_path / "lig", factors, progress=False, reference="liggghts")
     ref, _ = run_precision("drag", ["pyref"], tmp_path / "ref", factors, progress=False)

@@ -14,17 +14,15 @@ import numpy as np
 import pytest
 
 from stickslip import adapters
+from conftest import skip_engine
 from test_stability import make, random_parameter_scene
 
 ENGINES = ["liggghts", "liggghts-exact", "yade"]
 
 
 def engine_or_skip(name):
-    adapter = adapters.get(name.removesuffix("-exact"))
-    reason = adapter.available()
-    if reason is not None:
-        pytest.skip(f"{name}: {reason}")
-    return adapter
+    skip_engine(name.removesuffix("-exact"))
+    return adapters.get(name.removesuffix("-exact"))
 
 
 def engine_run(engine, sc, tmp_path):

@@ -13,14 +13,15 @@ after one step, then chaos), so there the law's own result at the first resumed 
 must be bit-identical (its inputs still are).
 """
 import json
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
 LAW = Path(__file__).resolve().parent.parent / "yade_law"
-pytestmark = pytest.mark.skipif(shutil.which("yade") is None, reason="yade not on PATH (apt-get install yade)")
+from conftest import needs_engine  # noqa: E402
+
+pytestmark = needs_engine("yade")
 
 SCENE = """
 import builtins, json, sys, numpy as np

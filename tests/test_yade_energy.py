@@ -8,14 +8,15 @@ time discretisation (derived below).
 """
 import json
 import math
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
 
 LAW = Path(__file__).resolve().parent.parent / "yade_law"
-pytestmark = pytest.mark.skipif(shutil.which("yade") is None, reason="yade not on PATH (apt-get install yade)")
+from conftest import needs_engine  # noqa: E402
+
+pytestmark = needs_engine("yade")
 
 KN, NU_N, KS, MU_S, MU_K = 1e4, 0.5, 8e3, 0.5, 0.4
 DT, STEPS = 4e-6, 30000  # 0.12 s: the spheres fall ~2 cm, collide, pile up and slide

@@ -1,6 +1,5 @@
 """The YADE law against pyref on the paper's cases (issue 4), and its parameter errors."""
 import math
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -11,13 +10,13 @@ import pytest
 from stickslip import analysis
 from stickslip import scene as scene_mod
 from stickslip.adapters import yade as yade_adapter
-from conftest import paper_case, run_pyref
+from conftest import needs_engine, paper_case, run_pyref
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "yade_law"))
 from stickslip_yade import check_parameters  # noqa: E402  (pure Python, no YADE needed)
 
-needs_yade = pytest.mark.skipif(shutil.which("yade") is None, reason="yade not installed (apt-get install yade)")
+needs_yade = needs_engine("yade")
 
 
 @pytest.mark.parametrize("kw,words", [

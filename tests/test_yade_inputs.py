@@ -4,7 +4,6 @@ allowed), numpy scalars are numbers, and a run whose values go non-finite stops 
 message naming the body or contact and the iteration, also through run_scene.py (one
 `ERROR` line, non-zero exit)."""
 import json
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -13,7 +12,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 LAW = ROOT / "yade_law"
-pytestmark = pytest.mark.skipif(shutil.which("yade") is None, reason="yade not on PATH (apt-get install yade)")
+from conftest import needs_engine  # noqa: E402
+
+pytestmark = needs_engine("yade")
 
 ARGS = """
 import json, sys, numpy as np

@@ -5,7 +5,6 @@ first step the trial force reaches mu_s*Fn, so times are known to one step).
 """
 import json
 import math
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -17,7 +16,9 @@ ROOT = Path(__file__).resolve().parent.parent
 LAW = ROOT / "yade_law"
 sys.path.insert(0, str(ROOT))
 from pyref.laws import LawParams, normal_force, rotate_history, tangential_force  # noqa: E402
-pytestmark = pytest.mark.skipif(shutil.which("yade") is None, reason="yade not on PATH (apt-get install yade)")
+from conftest import needs_engine  # noqa: E402
+
+pytestmark = needs_engine("yade")
 
 # example_drag.py's parameters (the paper's Table 2 and section 3.1)
 R, RHO, G, V = 0.002, 2600.0, 9.81, 1e-5

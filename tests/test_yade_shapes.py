@@ -12,7 +12,6 @@
 import json
 import math
 import re
-import shutil
 import subprocess
 from pathlib import Path
 
@@ -21,7 +20,9 @@ import pytest
 
 LAW = Path(__file__).resolve().parent.parent / "yade_law"
 EXAMPLES = Path("/usr/share/doc/yade/examples")
-pytestmark = pytest.mark.skipif(shutil.which("yade") is None, reason="yade not on PATH (apt-get install yade)")
+from conftest import needs_engine, skip_engine  # noqa: E402
+
+pytestmark = needs_engine("yade")
 
 KN, KS, MU, R, DT, DELTA = 1e4, 8e3, 0.4, 0.01, 1e-5, 1e-4
 
@@ -282,7 +283,7 @@ def test_shipped_examples_run_with_the_law(tmp_path, example):
     kinetic energy below what the bodies started with plus the potential energy of their
     fall to the container's bottom."""
     if not EXAMPLES.is_dir():
-        pytest.skip("YADE's examples are not installed (/usr/share/doc/yade/examples)")
+        skip_engine("yade", "YADE's examples are not installed (/usr/share/doc/yade/examples)")
     mu35 = math.tan(math.radians(35))
     law = f"ks=5e5, nu_s=0.0, mu_s={mu35:.6f}, mu_k={0.9 * mu35:.6f}"
     if example == "baraban":

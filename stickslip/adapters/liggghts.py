@@ -28,7 +28,8 @@ from . import RunResult
 NAME = "liggghts"
 REPO = Path(__file__).resolve().parents[2]
 # The plugin build (./run.sh setup): the launcher and the preloadable library. Defined here only.
-BUILD = REPO / "build" / "liggghts_plugin"
+# STICKSLIP_LIGGGHTS_BUILD points it at another build (tools/mutate_cpp.py: a mutant's).
+BUILD = Path(os.environ.get("STICKSLIP_LIGGGHTS_BUILD") or REPO / "build" / "liggghts_plugin")
 LAUNCHER = BUILD / "liggghts-stickslip"
 PRELOAD = BUILD / "libstickslip_liggghts.so"
 # contact history layout of the stick_slip model with the record on (1-based, as LIGGGHTS counts):

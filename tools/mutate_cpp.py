@@ -1,0 +1,225 @@
+#!/usr/bin/env python3
+"""Small deliberate bugs in the C++ law, each built and run against the tests: does the
+suite see it? (issue 31 item 5; the README's test section quotes the last result.)
+
+    .venv/bin/python tools/mutate_cpp.py [--engine liggghts] [--only ID ...] [--wide]
+
+For each mutant: copy the engine's source folder into build/mutants/<engine>/src (the
+repository's files are never touched), apply the mutant to the copy, rebuild in
+build/mutants/<engine>/build, and run the engine's test selection with the adapter
+pointed at that build (STICKSLIP_LIGGGHTS_BUILD). A mutant is found by the text it
+changes (a regular expression, whitespace-insensitive, that must match exactly `count`
+times), never by line number: a mutant whose text is not found, or found a different
+number of times, is an ERROR in the summary and makes the exit status 2, never a silent
+skip. Killed = some test failed; survived = the selection passed.
+
+Selections: first the fast one (the law's contract on the engine, ~10 s); a mutant it
+does not kill is run against the engine's whole default test selection (`--wide` runs
+that for every mutant, to name every test that kills it). Builds are -O0 (3x faster to
+compile; IEEE arithmetic without FMA contraction gives the same numbers as -O2: the
+baseline must pass the same tests before any mutant runs).
+
+A third engine (LAMMPS) is one more entry in ENGINES: its source folder, the file the
+law lives in, the environment variable its adapter reads, its test selections, and its
+mutants (the same kinds, found in its own text).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+PYTHON = REPO / ".venv" / "bin" / "python"
+
+
+@dataclass(frozen=True)
+class Mutant:
+    id: str
+    kind: str  # the kind of bug issue 31 names
+    find: str  # the text to change (whitespace-insensitive)
+    replace: str
+    count: int = 1  # how many times `find` must occur (all are changed)
+
+
+@dataclass(frozen=True)
+class Engine:
+    source: str  # folder copied and built
+    law_file: str  # the file mutated, inside `source`
+    build_env: str  # the adapter's variable for the build folder
+    fast: tuple  # pytest arguments: the selection every mutant runs
+    wide: tuple  # the engine's default-suite tests, for mutants the fast one misses
+    mutants: tuple
+
+
+LIGGGHTS_MUTANTS = (
+    Mutant("fmin_step_0.3pct", "Fmin off by 0.3 %",
+           "const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;",
+           "const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn * 1.003;"),
+    Mutant("fmin_exact_0.3pct", "Fmin off by 0.3 %",
+           "const double fmin = (2.0 * mk - ms) * fn;", "const double fmin = (2.0 * mk - ms) * fn * 1.003;"),
+    Mutant("threshold_gt_step", "> for >= at the threshold",
+           "bool slip = mag2 >= limit * limit;", "bool slip = mag2 > limit * limit;"),
+    Mutant("threshold_gt_exact_start", "> for >= at the threshold",
+           "const bool start_over = start2 >= limit * limit;", "const bool start_over = start2 > limit * limit;"),
+    Mutant("threshold_gt_exact_loop", "> for >= at the threshold",
+           "if (slips == 0 && F2 >= T * T) dtheta = 0.0;", "if (slips == 0 && F2 > T * T) dtheta = 0.0;"),
+    Mutant("reset_spring_sign", "sign error in the spring reset",
+           "reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;",
+           "reset_total ? -(F[k] + gammat * vs[k]) / kt : F[k] / kt;"),
+    Mutant("reset_total_sign", "sign error in the spring reset",
+           "reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;",
+           "reset_total ? -(F[k] - gammat * vs[k]) / kt : -F[k] / kt;"),
+    Mutant("reset_exact_end_sign", "sign error in the spring reset",
+           "D[k] = -(trial[k] + gammat * vs[k]) / kt;", "D[k] = -(trial[k] - gammat * vs[k]) / kt;"),
+    Mutant("dashpot_sign", "sign error in the dashpot",
+           "F[k] = -kt * D[k] - gammat * vs[k];", "F[k] = -kt * D[k] + gammat * vs[k];"),
+    Mutant("dashpot_sign_exact_start", "sign error in the dashpot",
+           "const double F00 = F[0] + ktdt * vs[0], F01 = F[1] + ktdt * vs[1], F02 = F[2] + ktdt * vs[2];",
+           "const double F00 = F[0] - ktdt * vs[0], F01 = F[1] - ktdt * vs[1], F02 = F[2] - ktdt * vs[2];"),
+    Mutant("turn_loses_length", "a turned history that loses its length",
+           "scale = new2 > 0.0 ? std::sqrt(old2 / new2) : 1.0;", "scale = 1.0;"),
+    Mutant("turn_series_loses_length", "a turned history that loses its length",
+           "double scale = 1.0 + x * (0.5 + 0.375 * x);", "double scale = 1.0;"),
+    Mutant("exact_misses_whole_cycles", "exact timing that misses a slip inside the step",
+           "const double n = std::floor(rest / L);", "const double n = 0.0;"),
+    Mutant("exact_misses_slip_at_start", "exact timing that misses a slip inside the step",
+           "slip = slip || start_over;", "slip = slip;"),
+    Mutant("exact_slip_late", "exact timing that misses a slip inside the step",
+           "dtheta = rate > 0.0 ? gap / rate : INFINITY;", "dtheta = rate > 0.0 ? 1.5 * gap / rate : INFINITY;"),
+    Mutant("mu_s_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
+           "const double ms = mu_s[sidata.itype][sidata.jtype];",
+           "const double ms = mu_s[sidata.itype][sidata.itype];"),
+    Mutant("mu_k_wrong_pair_step", "a per-type-pair coefficient read from the wrong pair",
+           "(2.0 * mu_k[sidata.itype][sidata.jtype] - ms)", "(2.0 * mu_k[sidata.jtype][sidata.jtype] - ms)"),
+    Mutant("mu_k_wrong_pair_exact", "a per-type-pair coefficient read from the wrong pair",
+           "const double mk = mu_k[sidata.itype][sidata.jtype];",
+           "const double mk = mu_k[sidata.itype][sidata.itype];"),
+    Mutant("reset_total_ignored_step", "the reset rule `total` ignored",
+           "reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;", "-F[k] / kt;"),
+    Mutant("reset_total_ignored_exact", "the reset rule `total` ignored",
+           "const double kept = reset_total ? 0.0 : gammat * speed;", "const double kept = gammat * speed;"),
+    Mutant("recontact_keeps_spring", "re-contact does not start from a zero spring",
+           "if (fresh) D[0] = D[1] = D[2] = 0.0;", ""),
+    Mutant("wall_close_keeps_spring", "re-contact does not start from a zero spring",
+           "hist[0] = hist[1] = hist[2] = 0.0;", ""),
+    Mutant("fn_signed", "|Fn| for a tensile Fn",
+           "const double fn = std::fabs(sidata.Fn);", "const double fn = sidata.Fn;"),
+)
+
+ENGINES = {
+    "liggghts": Engine(
+        source="liggghts_plugin", law_file="tangential_model_stick_slip.h", build_env="STICKSLIP_LIGGGHTS_BUILD",
+        fast=("tests/test_law_contract.py", "-k", "liggghts"),
+        wide=("tests/test_liggghts_plugin.py", "tests/test_liggghts_engine.py", "tests/test_liggghts_dropin.py",
+              "tests/test_stability_engines.py", "tests/test_drum.py", "tests/test_precision.py",
+              "-k", "liggghts"),
+        mutants=LIGGGHTS_MUTANTS),
+    # "lammps": Engine(source="lammps_plugin", law_file=..., build_env="STICKSLIP_LAMMPS_BUILD", ...),
+}
+
+
+def pattern(text):
+    """`text` as a regular expression in which any run of whitespace matches any other."""
+    return re.compile(r"\s*".join(re.escape(part) for part in text.split()))
+
+
+def apply(source: str, m: Mutant) -> str:
+    """The source with the mutant applied; ValueError (the summary's ERROR) when its text is
+    not found exactly m.count times."""
+    found = pattern(m.find).findall(source)
+    if len(found) != m.count:
+        raise ValueError(f"text found {len(found)} times, expected {m.count}: {m.find!r}")
+    return pattern(m.find).sub(lambda _: m.replace, source)
+
+
+def build(src: Path, out: Path):
+    if not (out / "CMakeCache.txt").exists():
+        subprocess.run(["cmake", "-S", str(src), "-B", str(out), "-DCMAKE_BUILD_TYPE=MutantO0",
+                        "-DCMAKE_CXX_FLAGS_MUTANTO0=-O0"], check=True, capture_output=True, text=True)
+    proc = subprocess.run(["cmake", "--build", str(out), "-j", "2"], capture_output=True, text=True)
+    return proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+
+
+def run_tests(args, env, jobs):
+    """pytest on a selection; returns (passed, the failing tests' names, seconds)."""
+    t0 = time.perf_counter()
+    cmd = [str(PYTHON), "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider", "-n", str(jobs), *args]
+    proc = subprocess.run(cmd, cwd=REPO, env=env, capture_output=True, text=True)
+    failed = sorted(set(re.findall(r"^FAILED (\S+)", proc.stdout, re.M) + re.findall(r"^ERROR (\S+)", proc.stdout, re.M)))
+    return proc.returncode == 0, failed, time.perf_counter() - t0, proc.stdout[-1500:]
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--engine", choices=sorted(ENGINES), default="liggghts")
+    ap.add_argument("--only", nargs="+", help="mutant ids to run (default: all)")
+    ap.add_argument("--wide", action="store_true", help="run the wide selection for every mutant")
+    ap.add_argument("--jobs", type=int, default=2, help="pytest-xdist workers (default 2)")
+    args = ap.parse_args(argv)
+    eng = ENGINES[args.engine]
+    mutants = [m for m in eng.mutants if not args.only or m.id in args.only]
+    work = REPO / "build" / "mutants" / args.engine
+    src, out = work / "src", work / "build"
+    if src.exists():
+        shutil.rmtree(src)
+    shutil.copytree(REPO / eng.source, src)
+    law = src / eng.law_file
+    original = law.read_text()
+    env = dict(os.environ, **{eng.build_env: str(out)})
+    t_start = time.perf_counter()
+
+    # every mutant's text must be found before anything is built
+    results, texts = [], {}
+    for m in mutants:
+        try:
+            texts[m.id] = apply(original, m)
+        except ValueError as e:
+            results.append((m, "ERROR", str(e), 0.0))
+    ok, log = build(src, out)
+    if not ok:
+        sys.exit(f"mutate_cpp: the unmutated source does not build:\n{log}")
+    passed, failed, secs, tail = run_tests(eng.fast, env, args.jobs)
+    if not passed:
+        sys.exit(f"mutate_cpp: the unmutated build fails the fast selection ({failed}):\n{tail}")
+    print(f"baseline: built and passed the fast selection in {secs:.0f} s", flush=True)
+    try:
+        for m in mutants:
+            if m.id not in texts:
+                continue
+            law.write_text(texts[m.id])
+            t0 = time.perf_counter()
+            ok, log = build(src, out)
+            if not ok:
+                results.append((m, "killed", "does not compile", time.perf_counter() - t0))
+                continue
+            passed, failed, _, _ = run_tests(eng.fast, env, args.jobs)
+            verdict, by = ("killed", "fast: " + ", ".join(failed)) if not passed else ("survived", "")
+            if args.wide or passed:
+                wide_passed, wide_failed, _, _ = run_tests(eng.wide, env, args.jobs)
+                if not wide_passed:
+                    verdict, by = "killed", (by + "; " if by else "") + "wide: " + ", ".join(wide_failed)
+            results.append((m, verdict, by, time.perf_counter() - t0))
+            print(f"{m.id:28s} {verdict:8s} {time.perf_counter() - t0:5.0f} s  {by}", flush=True)
+    finally:
+        law.write_text(original)
+        build(src, out)  # leave the copy built as the repository's source
+    killed = sum(1 for _, v, _, _ in results if v == "killed")
+    errors = [r for r in results if r[1] == "ERROR"]
+    print(f"\n{args.engine}: {killed} of {len(results) - len(errors)} mutants killed, "
+          f"{len(results) - len(errors) - killed} survived, {len(errors)} not found (ERROR); "
+          f"{time.perf_counter() - t_start:.0f} s")
+    print("| mutant | kind | result | killed by |\n|---|---|---|---|")
+    for m, verdict, by, _ in results:
+        print(f"| {m.id} | {m.kind} | {verdict} | {by} |")
+    return 2 if errors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
