@@ -21,6 +21,13 @@ from . import adapters
 from . import scene as scene_mod
 
 REPORT_TARGET_S = 300  # issue 25: `./run.sh report` in at most 5 minutes on 2 cores
+# The pyref figures' sizes: packings for the scaling fit, each timed over about
+# STEP_BUDGET grain-steps; the ~10 000-contact packing (also the effects' and slip timings'
+# one), timed over TIMED_STEPS steps. (The test suite runs the command on small ones.)
+PYREF_SIZES = (1000, 5000, 20000)
+STEP_BUDGET = 200_000
+CONTACT_TARGET_GRAINS = 3400
+TIMED_STEPS = 60
 
 PACKING = """
 name = "packing"
@@ -108,11 +115,10 @@ def memory(sc):
 
 def pyref_rows(reps):
     rows = []
-    sizes = (1000, 5000, 20000)
     per_step = []
-    for n in sizes:
+    for n in PYREF_SIZES:
         sc = packing(n)
-        steps = max(10, 200_000 // n)
+        steps = max(10, STEP_BUDGET // n)
         t, c = time_steps(sc, steps, reps)
         per_step.append((len(sc.grains), t))
         rows.append({"benchmark": "pyref", "case": f"{len(sc.grains)} grains", "contacts": round(c),
@@ -121,8 +127,8 @@ def pyref_rows(reps):
     x, y = np.log([p[0] for p in per_step]), np.log([p[1] for p in per_step])
     rows.append({"benchmark": "pyref", "case": "scaling exponent (time/step ~ N^p)", "value": float(np.polyfit(x, y, 1)[0])})
     # The 10 000-contact point the target names: a packing of ~3 400 grains.
-    sc = packing(3400)
-    t, c = time_steps(sc, 60, reps)
+    sc = packing(CONTACT_TARGET_GRAINS)
+    t, c = time_steps(sc, TIMED_STEPS, reps)
     rows.append({"benchmark": "pyref", "case": "~10 000 contacts (target >= 2e6 contact-steps/s)",
                  "contacts": round(c), "seconds_per_step": t, "contact_steps_per_s": c / t})
     rows += timing_rows(reps)
@@ -133,11 +139,12 @@ def pyref_rows(reps):
     return rows
 
 
-def timing_rows(reps, n=3400):
+def timing_rows(reps, n=None):
     """Cost of the exact slip timing against the step timing, per contact-step, on the
     packing at rest (contacts stick: the exact mode only adds a threshold test) and set
     sliding (every grain with a random velocity of 0.05 m/s: contacts slip, several times
     a step, and the exact mode follows each slip). Same process, one after the other."""
+    n = n or CONTACT_TARGET_GRAINS
     rows = []
     for state, extra in (("at rest", {}), ("sliding", {"jitter": 0.05})):
         costs = {}
@@ -145,7 +152,7 @@ def timing_rows(reps, n=3400):
             sc = packing(n, slip_timing=timing)
             for g in sc.grains:  # seeded, the same for both modes
                 g.velocity = np.random.default_rng(hash(g.name) % 2**32).uniform(-1, 1, 3) * extra.get("jitter", 0.0)
-            t, c = time_steps(sc, 60, reps)
+            t, c = time_steps(sc, TIMED_STEPS, reps)
             costs[timing] = t / c
             rows.append({"benchmark": "pyref", "case": f"slip timing {timing}, packing {state}, s per contact-step",
                          "contacts": round(c), "value": t / c})
@@ -156,16 +163,16 @@ def timing_rows(reps, n=3400):
 
 def effect_rows(reps):
     """The same packing with each effect switched off in turn, against all on."""
-    n = 3400
-    base_t, c = time_steps(packing(n), 60, reps)
+    n = CONTACT_TARGET_GRAINS
+    base_t, c = time_steps(packing(n), TIMED_STEPS, reps)
     rows = [{"benchmark": "effects", "case": "all on", "contacts": round(c), "seconds_per_step": base_t,
              "ratio_to_all_on": 1.0}]
     for effect in ("gravity", "rotation", "normal_damping", "tangential_damping"):
-        t, c = time_steps(packing(n, **{f"effect_{effect}": False}), 60, reps)
+        t, c = time_steps(packing(n, **{f"effect_{effect}": False}), TIMED_STEPS, reps)
         rows.append({"benchmark": "effects", "case": f"{effect} off", "contacts": round(c), "seconds_per_step": t,
                      "ratio_to_all_on": t / base_t})
     off = {f"effect_{e}": False for e in ("gravity", "rotation", "normal_damping", "tangential_damping")}
-    t, c = time_steps(packing(n, **off), 60, reps)
+    t, c = time_steps(packing(n, **off), TIMED_STEPS, reps)
     rows.append({"benchmark": "effects", "case": "all off", "contacts": round(c), "seconds_per_step": t,
                  "ratio_to_all_on": t / base_t})
     return rows

@@ -92,6 +92,8 @@ def build_parser():
     be.add_argument("--out", type=_folder, default=Path("bench"), help="output folder (default: bench)")
     be.add_argument("--reps", type=_count, default=3, help="repetitions per figure (median quoted)")
     be.add_argument("--report", action="store_true", help="also time `stickslip report` (all engines and studies)")
+    be.add_argument("--engines", nargs="+", choices=ENGINES,
+                    help="engines whose own benchmarks run besides pyref's (default: every available one)")
 
     ds = sub.add_parser("drum-study", help="avalanches in a turning drum on LIGGGHTS: history vs stick-slip "
                                            "(docs/drum.md); resumes an interrupted study")
@@ -224,7 +226,7 @@ def cmd_bench(args):
     from .bench import run_bench
     from .runner import prepare_output
 
-    run_bench(prepare_output(args.out), reps=args.reps, report=args.report)
+    run_bench(prepare_output(args.out), reps=args.reps, engines=args.engines, report=args.report)
     return 0
 
 
