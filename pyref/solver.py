@@ -152,6 +152,7 @@ class Simulation:
         self.names = {q.name: i for i, q in enumerate(g)}
         self.names.update({w.name: self.N + k for k, w in enumerate(s.walls)})
         self.slip_steps = 0
+        self.last_e_t = np.zeros(0)  # per contact, what the tangential law dissipated in the last step (energy on)
         self.slip_stats = s.output.slip_stats  # output.slip_stats: |V_s| of each contact kept
         self.vs_mag = np.zeros(0)
         self.record = record

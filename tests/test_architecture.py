@@ -66,7 +66,8 @@ def test_the_cycle_finder_finds_a_cycle():
 
 def test_no_import_circles():
     g = graph()
-    assert len(g) > 20 and "stickslip.runner" in g["stickslip.cli"] | {"stickslip.runner"}
+    # the graph holds imports made inside functions too (cli imports runner in cmd_run)
+    assert len(g) > 20 and "stickslip.runner" in g["stickslip.cli"]
     assert find_cycle(g) is None, " -> ".join(find_cycle(g))
 
 

@@ -80,10 +80,14 @@ def test_plain_slider_and_zero_fmin(engine, mu_k, mean, tmp_path):
 @pytest.mark.parametrize("engine", ENGINES)
 def test_contact_opening_while_sliding(engine, tmp_path):
     """A grain bouncing while dragged: the contact opens and closes; Fs = 0 whenever
-    Fn = 0 (checked in run_checked) and the contact did open."""
-    sc = make(vel=[0.01, 0.0], imposed=["x"], height=0.005 - 2e-5, nu_n=0.0, duration=0.02, dt=2e-6)
+    Fn = 0 (checked in run_checked), the contact did open and land again (twice: starting
+    5 um deep it flies ~8 ms a bounce, test_stability's scene) and slipped. (That a landing
+    starts from a zero spring is the law contract's: tests/law_contract.py, recontact.)"""
+    sc = make(vel=[0.01, 0.0], imposed=["x"], height=0.005 - 5e-6, nu_n=0.0, duration=0.02, dt=5e-6)
     df = run_checked(engine, sc, tmp_path)
-    assert (df["g-floor_fn"].iloc[1:] == 0).any() and df["g-floor_slip"].sum() > 0
+    touching = df["g-floor_fn"].to_numpy()[1:] > 0
+    landings = int(np.count_nonzero(touching[1:] & ~touching[:-1]))
+    assert landings >= 2 and df["g-floor_slip"].sum() > 0, landings
 
 
 @pytest.mark.parametrize("engine", ENGINES)
