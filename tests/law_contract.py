@@ -162,6 +162,19 @@ def _cases():
     cases.append(Case("slip_at_step_start_exact_timing", "E0, E2: |F_0| >= mu_s Fn slips at once",
                       "wall", (Segment(18, ALONG_X), Segment(3, (-0.25, 0.0, 0.0), delta=3.0 / 128)),
                       24 * X, 18 * X, timing="exact"))
+    # Exact timing, several slips in one step (E7's whole cycles): T = 20, Fmin = 12
+    # (mu_k = 16 w) and 32 w a step along x. Step 1 loads from 0 to T at theta = 20/32 =
+    # 5/8, then cycles of 8/32 = 1/4 of a step: one whole, and 1/8 left: 12 + 4 = 16.
+    # Every later step starts at 16, slips at 1/8 and ends the same way: 16.
+    cases.append(Case("several_slips_in_a_step_exact_timing", "E7: the rest of the step in whole cycles",
+                      "wall", (Segment(4, (8.0, 0.0, 0.0)),), 20 * X, 16 * X, timing="exact"))
+    # Exact timing with mu_k = mu_s and no dashpot (E6, plastic flow): 24 steps along +x
+    # load the spring to T (the 24th slips at its very end, with no time left), then the
+    # grain slides along (3, 4)/5: the force stays on |F| = T and turns towards u = -V/|V|,
+    # tan(phi/2) falling by exp(-Ks|V|dt/T) over the step (phi: from F to u).
+    cases.append(Case("plastic_flow_exact_timing", "E6: mu_k = mu_s, the force turns on |F| = T",
+                      "wall", (Segment(24, ALONG_X), Segment(1, DIAGONAL)), 24 * X, 24 * X, timing="exact",
+                      ulps=16, why_ulps="an exponential and a dozen roundings on the turned force's path"))
     # Fn = 0 (step 2: never tensile). kn delta + nu_n v_n with v_n = -1/2 (grain leaving):
     # nu_n = 2 gives 1 - 1 = 0 exactly, nu_n = 4 gives -1, clipped to 0. No friction:
     # every step slips (0 >= 0), force 0, spring reset: 0 (spring) or -nu_s V/Ks (total:
@@ -219,6 +232,10 @@ def expected(case: Case):
         return sawtooth(1, 0, {20, 32}, 12, 4, "total", n)
     if name.startswith("slip_inside_step"):
         return _inside_step(case)
+    if name == "several_slips_in_a_step_exact_timing":
+        return [Expect(1.0, 0.5, 0.5, k) for k in range(1, n + 1)]  # 16 X = w/2 (w = 32 X)
+    if name == "plastic_flow_exact_timing":
+        return [Expect(1.0, k, k, 0) for k in range(1, 24)] + [Expect(1.0, 24, 24, 1), _plastic_flow_step()]
     if name == "slip_at_step_start_exact_timing":
         turned = [Expect(0.75, (f * X, 0.0, 0.0), (f * X, 0.0, 0.0), 1) for f in (8, 7, 6)]
         return [Expect(1.0, k, k, 0) for k in range(1, 19)] + turned
@@ -233,6 +250,18 @@ def expected(case: Case):
     if name.startswith("stuck_pair_turning"):
         return None  # checked by check_turning
     raise KeyError(name)
+
+
+def _plastic_flow_step():
+    """E6 by hand: F = -T x at the start (T = 24/64), u = -(3, 4, 0)/5: the angle phi from F
+    to u has cos 3/5, sin 4/5, tan(phi/2) = (4/5)/(1 + 3/5) = 1/2; the part of F across u
+    points along p = (-4, 3, 0)/5. Over the step tan(phi/2) falls to s = exp(-rate/T)/2,
+    rate = Ks |V| dt = 5/256, and F = T ((1 - s^2) u + 2 s p)/(1 + s^2); D = -F/Ks."""
+    T = 24 * X
+    s = 0.5 * math.exp(-(5 / 256) / T)
+    u, p = np.array([-0.6, -0.8, 0.0]), np.array([-0.8, 0.6, 0.0])
+    F = T * ((1 - s * s) * u + 2 * s * p) / (1 + s * s)
+    return Expect(1.0, tuple(-F), tuple(-F), 2)
 
 
 def _inside_step(case):
