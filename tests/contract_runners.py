@@ -14,6 +14,7 @@ turn them rigidly (`fix move`).
 from __future__ import annotations
 
 import math
+import os
 import subprocess
 import tempfile
 from pathlib import Path
@@ -195,8 +196,11 @@ def run_liggghts_script(script, work: Path):
     from stickslip.adapters.liggghts import LAUNCHER
 
     (work / "in.contract").write_text(script)
+    # a serial run needs no MPI daemon: OpenMPI's isolated singleton starts none (measured:
+    # 0.35 s less a run, about half of a case's cost)
+    env = dict(os.environ, OMPI_MCA_ess_singleton_isolated="1")
     proc = subprocess.run([str(LAUNCHER), "-in", "in.contract", "-echo", "none", "-log", "log.contract"],
-                          cwd=work, capture_output=True, text=True, errors="replace", timeout=120)
+                          cwd=work, capture_output=True, text=True, errors="replace", timeout=120, env=env)
     errors = [line for line in proc.stdout.split("\n") if line.startswith("ERROR")]
     assert proc.returncode == 0 and not errors, (proc.returncode, errors, proc.stdout[-2000:], proc.stderr[-2000:])
 

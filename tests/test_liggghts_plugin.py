@@ -67,6 +67,8 @@ def run_liggghts(tmp_path, name, script, exe=None, np_=1, env=None, timeout=600,
     exe = str(exe or LAUNCHER)
     cmd = [exe, "-in", f"in.{name}", "-log", f"log.{name}", "-echo", "none"]
     full_env = dict(os.environ, **(env or {}))
+    if np_ == 1:  # no MPI daemon for one process (stickslip/adapters/liggghts.py: 0.35 s a run)
+        full_env.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
     if np_ > 1:
         cmd = ["mpirun", "-np", str(np_), "--oversubscribe"] + cmd
         full_env.update(MPI_ENV)
