@@ -234,7 +234,7 @@ def run_liggghts(case):
     return out
 
 
-def run_liggghts_type_pairs():
+def run_liggghts_type_pairs(timing="step"):
     """Five contacts side by side, one per pair of types with different coefficients
     (law_contract.TYPE_PAIRS): grains of types 2 and 3 on the wall (type 1), sliding along x,
     and pairs 2-3, 2-2, 3-3 (normal x) sliding along y. Returns {type pair: trace}."""
@@ -242,7 +242,8 @@ def run_liggghts_type_pairs():
     mu_s = " ".join(_f(coeff[tuple(sorted((i, j)))][0]) for i in (1, 2, 3) for j in (1, 2, 3))
     mu_k = " ".join(_f(coeff[tuple(sorted((i, j)))][1]) for i in (1, 2, 3) for j in (1, 2, 3))
     same = lambda v: " ".join([_f(v)] * 9)  # noqa: E731
-    settings = "absolute_damping on limitForce on stick_slip_record on"
+    settings = "absolute_damping on limitForce on stick_slip_record on" + (
+        " exact_slip_timing on" if timing == "exact" else "")
     d = 2 * lc.R - lc.DELTA
     z = lc.R - lc.DELTA
     # (id, type, position, velocity): two grains on the floor, then three pairs up high
