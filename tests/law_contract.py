@@ -175,6 +175,18 @@ def _cases():
     cases.append(Case("plastic_flow_exact_timing", "E6: mu_k = mu_s, the force turns on |F| = T",
                       "wall", (Segment(24, ALONG_X), Segment(1, DIAGONAL)), 24 * X, 24 * X, timing="exact",
                       ulps=16, why_ulps="an exponential and a dozen roundings on the turned force's path"))
+    # Exact timing, the dashpot's sliding regime (E4): nu_s V = 16 w with T = 24, Fmin = 12
+    # (reset spring): the trial force k + 16 reaches T at the end of step 8; restarted at
+    # Fmin + kept = 28 >= T it slides: applied Fmin = 12 along -V, spring 28 - 16 = 12, and
+    # so every later step (the step timing's result too: slides at Fmin).
+    cases.append(Case("dashpot_keeps_it_sliding_exact_timing", "E4: restarted above T, slides at Fmin",
+                      "wall", (Segment(12, ALONG_X),), 24 * X, 18 * X, nu_s=1.0, timing="exact"))
+    # Exact timing, nothing moving (E5): 18 steps load the spring to 18 (T = 24), then the
+    # grain stops and Fn falls to 3/4 (T = 18, the force is at it): it slips at once to
+    # Fmin = 9 and, with no motion, stays there.
+    cases.append(Case("slip_without_motion_exact_timing", "E5: rate = 0, the force stays where the slip left it",
+                      "wall", (Segment(18, ALONG_X), Segment(3, (0.0, 0.0, 0.0), delta=3.0 / 128)),
+                      24 * X, 18 * X, timing="exact"))
     # Fn = 0 (step 2: never tensile). kn delta + nu_n v_n with v_n = -1/2 (grain leaving):
     # nu_n = 2 gives 1 - 1 = 0 exactly, nu_n = 4 gives -1, clipped to 0. No friction:
     # every step slips (0 >= 0), force 0, spring reset: 0 (spring) or -nu_s V/Ks (total:
@@ -232,6 +244,11 @@ def expected(case: Case):
         return sawtooth(1, 0, {20, 32}, 12, 4, "total", n)
     if name.startswith("slip_inside_step"):
         return _inside_step(case)
+    if name == "dashpot_keeps_it_sliding_exact_timing":
+        return sawtooth(1, 0, set(range(8, n + 1)), 12, 16, "spring", n)
+    if name == "slip_without_motion_exact_timing":
+        still = [Expect(0.75, (9 * X, 0.0, 0.0), (9 * X, 0.0, 0.0), 1) for _ in range(3)]
+        return [Expect(1.0, k, k, 0) for k in range(1, 19)] + still
     if name == "several_slips_in_a_step_exact_timing":
         return [Expect(1.0, 0.5, 0.5, k) for k in range(1, n + 1)]  # 16 X = w/2 (w = 32 X)
     if name == "plastic_flow_exact_timing":
