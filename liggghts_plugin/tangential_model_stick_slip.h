@@ -22,6 +22,7 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 #include "neighbor.h"
 #include "atom.h"
 #include "fix_property_atom.h"
+#include "stick_slip_path_counts.h"
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -120,6 +121,7 @@ namespace StickSlip {
     const double kept = reset_total ? 0.0 : gammat * speed;
     stick = 0.0;
     if (!(T > 0.0)) {  // E1: no normal force, no friction; the spring keeps what the reset leaves
+      STICK_SLIP_COUNT(GEN_E1);
       for (int k = 0; k < 3; k++) { applied[k] = 0.0; trial[k] = kept * u[k]; }
       return;
     }
@@ -136,6 +138,7 @@ namespace StickSlip {
         dtheta = rate > 0.0 ? gap / rate : INFINITY;
       }
       if (!(theta + dtheta <= 1.0)) {  // sticks to the end of the step
+        STICK_SLIP_COUNT(GEN_STICK_TO_END);
         const double rest = 1.0 - theta;
         for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];
         stick += rest;
@@ -150,21 +153,25 @@ namespace StickSlip {
       double t[3];
       for (int k = 0; k < 3; k++) t[k] = hit[k] / hn;
       slips++;
+      STICK_SLIP_COUNT(GEN_SLIP);
       for (int k = 0; k < 3; k++) F[k] = fmin * t[k] + kept * u[k];
       const double rest = 1.0 - theta;
       // E4: the restarted force is at or above T again: slips follow without end and turn t
       // onto u, the contact slides at Fmin u for the rest of the step
       if (kept > 0.0 && dot(F, F) >= T * T) {
+        STICK_SLIP_COUNT(GEN_E4);
         for (int k = 0; k < 3; k++) { trial[k] = (fmin + kept) * u[k]; applied[k] = fmin * u[k]; }
         return;
       }
       if (rate == 0.0) {  // E5: nothing moves, the force stays where the slip left it
+        STICK_SLIP_COUNT(GEN_E5);
         for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
         stick += rest;
         return;
       }
       const double along = dot(t, u);
       if (flow_law && along > 0.0) {  // E6: plastic flow on |F| = T
+        STICK_SLIP_COUNT(GEN_E6);
         plastic_flow(F, u, rate * rest / T, T);
         for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
         return;
@@ -176,6 +183,7 @@ namespace StickSlip {
       double q[3];
       for (int k = 0; k < 3; k++) q[k] = F[k] - fu * u[k];
       if ((std::sqrt(dot(q, q)) <= SETTLED * T && along > 0.0) || slips >= MAX_EXPLICIT_SLIPS) {
+        STICK_SLIP_COUNT(GEN_E7);
         const double low = fmin + kept;
         const double L = (T - low) / rate;
         if (!(L > 0.0)) {  // restarts at T: slides, as E4
@@ -312,6 +320,11 @@ public:
     const double fn = std::fabs(sidata.Fn);
     const bool update_history = sidata.computeflag && sidata.shearupdate;
     const bool energy = update_history && (heating || elasticpot || dissipated);
+    STICK_SLIP_COUNTING(true);
+    if (!update_history) STICK_SLIP_COUNT(CALL_NO_UPDATE);
+    else if (sidata.is_wall) STICK_SLIP_COUNT(CALL_WALL);
+    else STICK_SLIP_COUNT(CALL_PAIR);
+    STICK_SLIP_COUNTING(update_history);  // the paths below: evaluations that update the history
 
     double * const hist = &sidata.contact_history[history_offset];
     // a pair that did not touch at the previous pass is a new contact (see postSettings);
@@ -322,7 +335,10 @@ public:
     if (update_history && stamp_offset >= 0)
       fresh = sidata.contact_history[stamp_offset] != (last_pass >= 0.0 ? last_pass : this_pass - 1.0);
     double D[3] = { hist[0], hist[1], hist[2] };
-    if (fresh) D[0] = D[1] = D[2] = 0.0;
+    if (fresh) {
+      STICK_SLIP_COUNT(STAMP_FRESH);
+      D[0] = D[1] = D[2] = 0.0;
+    }
     const double spring_before = energy ? 0.5 * kt * StickSlip::dot(D, D) : 0.0;
     if (update_history) {
       const double dt = update->dt;
@@ -336,6 +352,7 @@ public:
         // 3D form: turn D into the current tangent plane, keeping its length (docs/law.md
         // step 3): D <- (D - dn n) * sqrt(old2/new2) with new2 = old2 (1 - x), x = dn^2/old2
         const double dn = D[0]*en[0] + D[1]*en[1] + D[2]*en[2];
+        if (dn == 0.0) STICK_SLIP_COUNT(TURN_NONE);
         if (dn != 0.0) {
           const double old2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
           const double x = dn * dn / old2;  // sin^2 of the angle between D and the plane
@@ -344,6 +361,8 @@ public:
           // (1 - x)^(-1/2), whose first dropped term, 5x^3/16 < 4e-19, is below round-off;
           // it spares the square root on the path every contact takes (1-2 % of a step, measured)
           double scale = 1.0 + x * (0.5 + 0.375 * x);
+          if (x < 1e-6) STICK_SLIP_COUNT(TURN_SERIES);
+          else STICK_SLIP_COUNT(TURN_SQRT);
           if (!(x < 1e-6)) {
             const double new2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
             scale = new2 > 0.0 ? std::sqrt(old2 / new2) : 1.0;
@@ -375,6 +394,7 @@ public:
       const double start2 = F00*F00 + F01*F01 + F02*F02;
       const bool start_over = start2 >= limit * limit;
       slip = slip || start_over;
+      if (!slip) STICK_SLIP_COUNT(EXACT_NO_SLIP);
       if (slip) {
         const double mk = mu_k[sidata.itype][sidata.jtype];
         const double fmin = (2.0 * mk - ms) * fn;
@@ -388,6 +408,7 @@ public:
           // with t0 = F0/|F0|, u = -V_s/|V_s| (expanded: one square root, no division). The
           // contact slides at Fmin u all step; the spring holds the trial force (Fmin +
           // nu_s |V_s|) u less the dashpot, i.e. Fmin u (eq. 5).
+          STICK_SLIP_COUNT(EXACT_E4_START);
           const double c = fmin / std::sqrt(vs2), ck = c / kt;
           for (int k = 0; k < 3; k++) {
             F[k] = -c * vs[k];
@@ -397,6 +418,7 @@ public:
         } else {
           // (exact_slips works on copies: an array whose address is passed on lives in
           // memory for the whole function, and F, vs are on the path every contact takes)
+          STICK_SLIP_COUNT(EXACT_GENERAL);
           const double F0[3] = { F00, F01, F02 }, v[3] = { vs[0], vs[1], vs[2] };
           const double r = (2.0 * mk - ms) / ms;  // Fmin/T, exactly 1 iff mu_k = mu_s
           // E6 applies when nothing is added at the reset (slip_reset_total, or no dashpot)
@@ -412,6 +434,7 @@ public:
         }
       }
     } else if (slip) {
+      STICK_SLIP_COUNT(STEP_SLIP);
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) Fn along the trial force
       const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;
       const double scale = mag2 > 0.0 ? fmin / std::sqrt(mag2) : 0.0;
@@ -421,6 +444,7 @@ public:
         D[k] = reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;
     }
 
+    if (!exact && !slip) STICK_SLIP_COUNT(STEP_STICK);
     if (update_history) {
       for (int k = 0; k < 3; k++) hist[k] = D[k];
       if (stamp_offset >= 0) sidata.contact_history[stamp_offset] = this_pass;
