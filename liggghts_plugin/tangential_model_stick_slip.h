@@ -210,6 +210,7 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
   int record_offset;    // optional diagnostics: Fn, F_s (3), slip count
   int stamp_offset;     // pair contacts: the time step at which the contact last touched
   double this_pass, last_pass;  // time steps of this and of the previous pass that updated histories
+  double touched_last;  // the stamp of a pair contact that touched at the previous pass (beginPass)
   bool reset_total;     // eq. 8: false = spring alone carries Fmin (paper), true = spring + dashpot
   bool record;
   bool exact;           // slips at their exact time inside the step (docs/law.md E0-E7)
@@ -217,6 +218,7 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
   bool keep_separated;  // history_on_separation keep: stock history's rule (see postSettings)
   // LIGGGHTS' energy and heat bookkeeping, as for `tangential history`
   bool heating, heating_track, elasticpot, dissipated;
+  bool energy_books;    // any of heating, elasticpot, dissipated (set once the settings are final)
   int elastic_potential_offset;
   FixPropertyAtom * fix_dissipated;
   ContactModelBase * cmb;
@@ -224,9 +226,9 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
 public:
   TangentialModel(LAMMPS * lmp, IContactHistorySetup * hsetup, class ContactModelBase * c) :
     TangentialModelBase(lmp, hsetup, c), mu_s(NULL), mu_k(NULL), history_offset(-1), record_offset(-1),
-    stamp_offset(-1), this_pass(-1.0), last_pass(-1.0), reset_total(false), record(false), exact(false),
+    stamp_offset(-1), this_pass(-1.0), last_pass(-1.0), touched_last(-2.0), reset_total(false), record(false), exact(false),
     project(false), keep_separated(false),
-    heating(false), heating_track(false), elasticpot(false), dissipated(false),
+    heating(false), heating_track(false), elasticpot(false), dissipated(false), energy_books(false),
     elastic_potential_offset(-1), fix_dissipated(NULL), cmb(c)
   {
     // "1": the value changes sign when the pair is seen from the other grain
@@ -302,12 +304,31 @@ public:
                             "ignored for walls, as for tangential history");
       elasticpot = dissipated = false;
     }
+    energy_books = heating || elasticpot || dissipated;
   }
 
   inline void surfacesIntersect(const SurfacesIntersectData & sidata, ForceData & i_forces, ForceData & j_forces)
   {
     if (sidata.contact_flags) *sidata.contact_flags |= CONTACT_TANGENTIAL_MODEL;
+    // the law compiled once per slip timing, and again for the common case (a step that
+    // updates the history, none of the options history_rotation project,
+    // stick_slip_record, energy books), whose copy has no tests of them
+    const bool plain = sidata.computeflag && sidata.shearupdate && !project && !record && !energy_books;
+    if (exact) {
+      if (plain) law<true, true>(sidata, i_forces, j_forces);
+      else law<true, false>(sidata, i_forces, j_forces);
+    } else {
+      if (plain) law<false, true>(sidata, i_forces, j_forces);
+      else law<false, false>(sidata, i_forces, j_forces);
+    }
+  }
 
+  // (inlined into the dispatch above, four copies of the law crowd the pair loop's registers:
+  // 1 % more instructions a step, measured; kept out of line by the compiler)
+  template<bool EXACT, bool PLAIN>
+  inline void law(const SurfacesIntersectData & sidata, ForceData & i_forces, ForceData & j_forces)
+  {
+    const bool exact = EXACT, project = !PLAIN && this->project, record = !PLAIN && this->record;
     const double * const en = sidata.en;
     const double vs[3] = { sidata.vtr1, sidata.vtr2, sidata.vtr3 };  // V_s, eq. 6
     const double kt = sidata.kt, gammat = sidata.gammat;             // Ks, nu_s from the normal model
@@ -318,8 +339,8 @@ public:
     // tensile Fn (limitForce off, adhesive models) the threshold uses |Fn| as LIGGGHTS'
     // tangential history does
     const double fn = std::fabs(sidata.Fn);
-    const bool update_history = sidata.computeflag && sidata.shearupdate;
-    const bool energy = update_history && (heating || elasticpot || dissipated);
+    const bool update_history = PLAIN || (sidata.computeflag && sidata.shearupdate);
+    const bool energy = !PLAIN && update_history && energy_books;
     STICK_SLIP_COUNTING(true);
     if (!update_history) STICK_SLIP_COUNT(CALL_NO_UPDATE);
     else if (sidata.is_wall) STICK_SLIP_COUNT(CALL_WALL);
@@ -327,21 +348,21 @@ public:
     STICK_SLIP_COUNTING(update_history);  // the paths below: evaluations that update the history
 
     double * const hist = &sidata.contact_history[history_offset];
-    // a pair that did not touch at the previous pass is a new contact (see postSettings);
-    // the first pass of this model (after read_restart, a new pair_style) takes step - 1.
+    // a pair that did not touch at the previous pass is a new contact (see postSettings).
     // (Only read here: the stamp is written with the history at the end, so that no store
     // into the history comes before the law's arithmetic.)
     bool fresh = false;
     if (update_history && stamp_offset >= 0)
-      fresh = sidata.contact_history[stamp_offset] != (last_pass >= 0.0 ? last_pass : this_pass - 1.0);
+      fresh = sidata.contact_history[stamp_offset] != touched_last;
     double D[3] = { hist[0], hist[1], hist[2] };
     if (fresh) {
       STICK_SLIP_COUNT(STAMP_FRESH);
       D[0] = D[1] = D[2] = 0.0;
     }
     const double spring_before = energy ? 0.5 * kt * StickSlip::dot(D, D) : 0.0;
+    // a re-evaluation without history update (run setup, computes) is a step of length 0
+    const double dt = update_history ? update->dt : 0.0;
     if (update_history) {
-      const double dt = update->dt;
       if (project) {
         // stock history: increment, then project onto the current tangent plane
         for (int k = 0; k < 3; k++) D[k] += vs[k] * dt;
@@ -386,8 +407,6 @@ public:
     if (exact) {
       // E0: |F| moves on a line during the step and is convex in time, so the step has no
       // slip iff it is below the threshold at both ends; then it is exactly the step above.
-      // A re-evaluation without history update (run setup, computes) is a step of length 0.
-      const double dt = update_history ? update->dt : 0.0;
       // the trial force at the step's start: the spring before the increment V_s dt
       const double ktdt = kt * dt;
       const double F00 = F[0] + ktdt * vs[0], F01 = F[1] + ktdt * vs[1], F02 = F[2] + ktdt * vs[2];
@@ -419,7 +438,9 @@ public:
           // (exact_slips works on copies: an array whose address is passed on lives in
           // memory for the whole function, and F, vs are on the path every contact takes)
           STICK_SLIP_COUNT(EXACT_GENERAL);
-          const double F0[3] = { F00, F01, F02 }, v[3] = { vs[0], vs[1], vs[2] };
+          // (F0 recomputed: F00, F01, F02 stay in registers on the common path)
+          const double F0[3] = { F[0] + ktdt * vs[0], F[1] + ktdt * vs[1], F[2] + ktdt * vs[2] };
+          const double v[3] = { vs[0], vs[1], vs[2] };
           const double r = (2.0 * mk - ms) / ms;  // Fmin/T, exactly 1 iff mu_k = mu_s
           // E6 applies when nothing is added at the reset (slip_reset_total, or no dashpot)
           const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);
@@ -564,6 +585,8 @@ public:
       last_pass = this_pass;
       this_pass = step;
     }
+    // the first pass of this model (after read_restart, a new pair_style) takes step - 1
+    touched_last = last_pass >= 0.0 ? last_pass : this_pass - 1.0;
   }
   inline void endPass(SurfacesIntersectData &, ForceData &, ForceData &) {}
 };
