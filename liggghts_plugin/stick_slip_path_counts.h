@@ -26,6 +26,7 @@ namespace StickSlipPaths {
   X(TURN_SQRT)          /* keep-length turn by the square root */ \
   X(STEP_STICK)         /* step timing: below the threshold */ \
   X(STEP_SLIP)          /* step timing: slip at the end of the step */ \
+  X(EXACT_START_OVER)   /* exact timing: at or above the threshold at the step's start */ \
   X(EXACT_NO_SLIP)      /* exact timing E0: below the threshold at both ends */ \
   X(EXACT_E4_START)     /* exact timing: E4 at the step's start, decided in the law */ \
   X(EXACT_GENERAL)      /* exact timing: the general routine exact_slips */ \

@@ -413,6 +413,7 @@ public:
       const double start2 = F00*F00 + F01*F01 + F02*F02;
       const bool start_over = start2 >= limit * limit;
       slip = slip || start_over;
+      if (start_over) STICK_SLIP_COUNT(EXACT_START_OVER);
       if (!slip) STICK_SLIP_COUNT(EXACT_NO_SLIP);
       if (slip) {
         const double mk = mu_k[sidata.itype][sidata.jtype];

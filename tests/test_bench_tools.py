@@ -85,3 +85,33 @@ def test_callgrind_total_refuses_a_file_without_summary(tmp_path):
     p.write_text("events: Ir\n")
     with pytest.raises(RuntimeError, match="no summary"):
         callgrind.total(p)
+
+
+# The same with one cost line per instruction (--dump-instr=yes: address, line, Ir), as the
+# path analysis reads it: f's instructions at 0x10, 0x14 (ran 5 times each), 0x18 (ran 2
+# times), the call at 0x1c (its line carries g's inclusive cost, not a run count).
+PROFILE_INSTR = """\
+# callgrind format
+version: 1
+positions: instr line
+events: Ir
+summary: 31
+
+fn=(1) f
+0x10 3 5
++4 3 5
++4 4 2
+cfn=(2) g
+calls=2 0x40 7
++4 5 10
+* 5 2
+fn=(2)
+0x40 7 7
+"""
+
+
+def test_callgrind_instruction_counts_read_each_instructions_runs(tmp_path):
+    p = tmp_path / "callgrind.out.1.1"
+    p.write_text(PROFILE_INSTR)
+    runs = callgrind.instruction_counts(p, lambda f: f == "f")
+    assert dict(runs) == {"f": {0x10: 5, 0x14: 5, 0x18: 2, 0x1C: 2}}
