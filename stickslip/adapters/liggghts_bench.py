@@ -650,7 +650,8 @@ def main(argv=None):
         ap.error(f"--baseline {a.baseline}: no such file (a built liggghts-stickslip)")
     t0 = time.perf_counter()
     try:
-        rows = benchmark(a.reps, a.rounds, counts=not a.no_callgrind, baseline=a.baseline)
+        rows = benchmark(a.reps, a.rounds, counts=not a.no_callgrind,
+                         baseline=a.baseline.resolve() if a.baseline else None)
     except RuntimeError as e:
         sys.stderr.write(f"liggghts_bench: {e}\n")
         return 1
