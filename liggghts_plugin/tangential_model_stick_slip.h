@@ -22,6 +22,7 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 #include "neighbor.h"
 #include "atom.h"
 #include "fix_property_atom.h"
+#include "stick_slip_path_counts.h"
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -120,6 +121,7 @@ namespace StickSlip {
     const double kept = reset_total ? 0.0 : gammat * speed;
     stick = 0.0;
     if (!(T > 0.0)) {  // E1: no normal force, no friction; the spring keeps what the reset leaves
+      STICK_SLIP_COUNT(GEN_E1);
       for (int k = 0; k < 3; k++) { applied[k] = 0.0; trial[k] = kept * u[k]; }
       return;
     }
@@ -136,6 +138,7 @@ namespace StickSlip {
         dtheta = rate > 0.0 ? gap / rate : INFINITY;
       }
       if (!(theta + dtheta <= 1.0)) {  // sticks to the end of the step
+        STICK_SLIP_COUNT(GEN_STICK_TO_END);
         const double rest = 1.0 - theta;
         for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];
         stick += rest;
@@ -150,21 +153,25 @@ namespace StickSlip {
       double t[3];
       for (int k = 0; k < 3; k++) t[k] = hit[k] / hn;
       slips++;
+      STICK_SLIP_COUNT(GEN_SLIP);
       for (int k = 0; k < 3; k++) F[k] = fmin * t[k] + kept * u[k];
       const double rest = 1.0 - theta;
       // E4: the restarted force is at or above T again: slips follow without end and turn t
       // onto u, the contact slides at Fmin u for the rest of the step
       if (kept > 0.0 && dot(F, F) >= T * T) {
+        STICK_SLIP_COUNT(GEN_E4);
         for (int k = 0; k < 3; k++) { trial[k] = (fmin + kept) * u[k]; applied[k] = fmin * u[k]; }
         return;
       }
       if (rate == 0.0) {  // E5: nothing moves, the force stays where the slip left it
+        STICK_SLIP_COUNT(GEN_E5);
         for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
         stick += rest;
         return;
       }
       const double along = dot(t, u);
       if (flow_law && along > 0.0) {  // E6: plastic flow on |F| = T
+        STICK_SLIP_COUNT(GEN_E6);
         plastic_flow(F, u, rate * rest / T, T);
         for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
         return;
@@ -176,6 +183,7 @@ namespace StickSlip {
       double q[3];
       for (int k = 0; k < 3; k++) q[k] = F[k] - fu * u[k];
       if ((std::sqrt(dot(q, q)) <= SETTLED * T && along > 0.0) || slips >= MAX_EXPLICIT_SLIPS) {
+        STICK_SLIP_COUNT(GEN_E7);
         const double low = fmin + kept;
         const double L = (T - low) / rate;
         if (!(L > 0.0)) {  // restarts at T: slides, as E4
@@ -202,6 +210,7 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
   int record_offset;    // optional diagnostics: Fn, F_s (3), slip count
   int stamp_offset;     // pair contacts: the time step at which the contact last touched
   double this_pass, last_pass;  // time steps of this and of the previous pass that updated histories
+  double touched_last;  // the stamp of a pair contact that touched at the previous pass (beginPass)
   bool reset_total;     // eq. 8: false = spring alone carries Fmin (paper), true = spring + dashpot
   bool record;
   bool exact;           // slips at their exact time inside the step (docs/law.md E0-E7)
@@ -209,6 +218,7 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
   bool keep_separated;  // history_on_separation keep: stock history's rule (see postSettings)
   // LIGGGHTS' energy and heat bookkeeping, as for `tangential history`
   bool heating, heating_track, elasticpot, dissipated;
+  bool energy_books;    // any of heating, elasticpot, dissipated (set once the settings are final)
   int elastic_potential_offset;
   FixPropertyAtom * fix_dissipated;
   ContactModelBase * cmb;
@@ -216,9 +226,9 @@ class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
 public:
   TangentialModel(LAMMPS * lmp, IContactHistorySetup * hsetup, class ContactModelBase * c) :
     TangentialModelBase(lmp, hsetup, c), mu_s(NULL), mu_k(NULL), history_offset(-1), record_offset(-1),
-    stamp_offset(-1), this_pass(-1.0), last_pass(-1.0), reset_total(false), record(false), exact(false),
+    stamp_offset(-1), this_pass(-1.0), last_pass(-1.0), touched_last(-2.0), reset_total(false), record(false), exact(false),
     project(false), keep_separated(false),
-    heating(false), heating_track(false), elasticpot(false), dissipated(false),
+    heating(false), heating_track(false), elasticpot(false), dissipated(false), energy_books(false),
     elastic_potential_offset(-1), fix_dissipated(NULL), cmb(c)
   {
     // "1": the value changes sign when the pair is seen from the other grain
@@ -294,12 +304,31 @@ public:
                             "ignored for walls, as for tangential history");
       elasticpot = dissipated = false;
     }
+    energy_books = heating || elasticpot || dissipated;
   }
 
   inline void surfacesIntersect(const SurfacesIntersectData & sidata, ForceData & i_forces, ForceData & j_forces)
   {
     if (sidata.contact_flags) *sidata.contact_flags |= CONTACT_TANGENTIAL_MODEL;
+    // the law compiled once per slip timing, and again for the common case (a step that
+    // updates the history, none of the options history_rotation project,
+    // stick_slip_record, energy books), whose copy has no tests of them
+    const bool plain = sidata.computeflag && sidata.shearupdate && !project && !record && !energy_books;
+    if (exact) {
+      if (plain) law<true, true>(sidata, i_forces, j_forces);
+      else law<true, false>(sidata, i_forces, j_forces);
+    } else {
+      if (plain) law<false, true>(sidata, i_forces, j_forces);
+      else law<false, false>(sidata, i_forces, j_forces);
+    }
+  }
 
+  // (inlined into the dispatch above, four copies of the law crowd the pair loop's registers:
+  // 1 % more instructions a step, measured; kept out of line by the compiler)
+  template<bool EXACT, bool PLAIN>
+  inline void law(const SurfacesIntersectData & sidata, ForceData & i_forces, ForceData & j_forces)
+  {
+    const bool exact = EXACT, project = !PLAIN && this->project, record = !PLAIN && this->record;
     const double * const en = sidata.en;
     const double vs[3] = { sidata.vtr1, sidata.vtr2, sidata.vtr3 };  // V_s, eq. 6
     const double kt = sidata.kt, gammat = sidata.gammat;             // Ks, nu_s from the normal model
@@ -310,22 +339,30 @@ public:
     // tensile Fn (limitForce off, adhesive models) the threshold uses |Fn| as LIGGGHTS'
     // tangential history does
     const double fn = std::fabs(sidata.Fn);
-    const bool update_history = sidata.computeflag && sidata.shearupdate;
-    const bool energy = update_history && (heating || elasticpot || dissipated);
+    const bool update_history = PLAIN || (sidata.computeflag && sidata.shearupdate);
+    const bool energy = !PLAIN && update_history && energy_books;
+    STICK_SLIP_COUNTING(true);
+    if (!update_history) STICK_SLIP_COUNT(CALL_NO_UPDATE);
+    else if (sidata.is_wall) STICK_SLIP_COUNT(CALL_WALL);
+    else STICK_SLIP_COUNT(CALL_PAIR);
+    STICK_SLIP_COUNTING(update_history);  // the paths below: evaluations that update the history
 
     double * const hist = &sidata.contact_history[history_offset];
-    // a pair that did not touch at the previous pass is a new contact (see postSettings);
-    // the first pass of this model (after read_restart, a new pair_style) takes step - 1.
+    // a pair that did not touch at the previous pass is a new contact (see postSettings).
     // (Only read here: the stamp is written with the history at the end, so that no store
     // into the history comes before the law's arithmetic.)
     bool fresh = false;
     if (update_history && stamp_offset >= 0)
-      fresh = sidata.contact_history[stamp_offset] != (last_pass >= 0.0 ? last_pass : this_pass - 1.0);
+      fresh = sidata.contact_history[stamp_offset] != touched_last;
     double D[3] = { hist[0], hist[1], hist[2] };
-    if (fresh) D[0] = D[1] = D[2] = 0.0;
+    if (fresh) {
+      STICK_SLIP_COUNT(STAMP_FRESH);
+      D[0] = D[1] = D[2] = 0.0;
+    }
     const double spring_before = energy ? 0.5 * kt * StickSlip::dot(D, D) : 0.0;
+    // a re-evaluation without history update (run setup, computes) is a step of length 0
+    const double dt = update_history ? update->dt : 0.0;
     if (update_history) {
-      const double dt = update->dt;
       if (project) {
         // stock history: increment, then project onto the current tangent plane
         for (int k = 0; k < 3; k++) D[k] += vs[k] * dt;
@@ -336,6 +373,7 @@ public:
         // 3D form: turn D into the current tangent plane, keeping its length (docs/law.md
         // step 3): D <- (D - dn n) * sqrt(old2/new2) with new2 = old2 (1 - x), x = dn^2/old2
         const double dn = D[0]*en[0] + D[1]*en[1] + D[2]*en[2];
+        if (dn == 0.0) STICK_SLIP_COUNT(TURN_NONE);
         if (dn != 0.0) {
           const double old2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
           const double x = dn * dn / old2;  // sin^2 of the angle between D and the plane
@@ -344,6 +382,8 @@ public:
           // (1 - x)^(-1/2), whose first dropped term, 5x^3/16 < 4e-19, is below round-off;
           // it spares the square root on the path every contact takes (1-2 % of a step, measured)
           double scale = 1.0 + x * (0.5 + 0.375 * x);
+          if (x < 1e-6) STICK_SLIP_COUNT(TURN_SERIES);
+          else STICK_SLIP_COUNT(TURN_SQRT);
           if (!(x < 1e-6)) {
             const double new2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
             scale = new2 > 0.0 ? std::sqrt(old2 / new2) : 1.0;
@@ -367,14 +407,14 @@ public:
     if (exact) {
       // E0: |F| moves on a line during the step and is convex in time, so the step has no
       // slip iff it is below the threshold at both ends; then it is exactly the step above.
-      // A re-evaluation without history update (run setup, computes) is a step of length 0.
-      const double dt = update_history ? update->dt : 0.0;
       // the trial force at the step's start: the spring before the increment V_s dt
       const double ktdt = kt * dt;
       const double F00 = F[0] + ktdt * vs[0], F01 = F[1] + ktdt * vs[1], F02 = F[2] + ktdt * vs[2];
       const double start2 = F00*F00 + F01*F01 + F02*F02;
       const bool start_over = start2 >= limit * limit;
       slip = slip || start_over;
+      if (start_over) STICK_SLIP_COUNT(EXACT_START_OVER);
+      if (!slip) STICK_SLIP_COUNT(EXACT_NO_SLIP);
       if (slip) {
         const double mk = mu_k[sidata.itype][sidata.jtype];
         const double fmin = (2.0 * mk - ms) * fn;
@@ -388,6 +428,7 @@ public:
           // with t0 = F0/|F0|, u = -V_s/|V_s| (expanded: one square root, no division). The
           // contact slides at Fmin u all step; the spring holds the trial force (Fmin +
           // nu_s |V_s|) u less the dashpot, i.e. Fmin u (eq. 5).
+          STICK_SLIP_COUNT(EXACT_E4_START);
           const double c = fmin / std::sqrt(vs2), ck = c / kt;
           for (int k = 0; k < 3; k++) {
             F[k] = -c * vs[k];
@@ -397,7 +438,10 @@ public:
         } else {
           // (exact_slips works on copies: an array whose address is passed on lives in
           // memory for the whole function, and F, vs are on the path every contact takes)
-          const double F0[3] = { F00, F01, F02 }, v[3] = { vs[0], vs[1], vs[2] };
+          STICK_SLIP_COUNT(EXACT_GENERAL);
+          // (F0 recomputed: F00, F01, F02 stay in registers on the common path)
+          const double F0[3] = { F[0] + ktdt * vs[0], F[1] + ktdt * vs[1], F[2] + ktdt * vs[2] };
+          const double v[3] = { vs[0], vs[1], vs[2] };
           const double r = (2.0 * mk - ms) / ms;  // Fmin/T, exactly 1 iff mu_k = mu_s
           // E6 applies when nothing is added at the reset (slip_reset_total, or no dashpot)
           const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);
@@ -412,6 +456,7 @@ public:
         }
       }
     } else if (slip) {
+      STICK_SLIP_COUNT(STEP_SLIP);
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) Fn along the trial force
       const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;
       const double scale = mag2 > 0.0 ? fmin / std::sqrt(mag2) : 0.0;
@@ -421,6 +466,7 @@ public:
         D[k] = reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;
     }
 
+    if (!exact && !slip) STICK_SLIP_COUNT(STEP_STICK);
     if (update_history) {
       for (int k = 0; k < 3; k++) hist[k] = D[k];
       if (stamp_offset >= 0) sidata.contact_history[stamp_offset] = this_pass;
@@ -540,6 +586,8 @@ public:
       last_pass = this_pass;
       this_pass = step;
     }
+    // the first pass of this model (after read_restart, a new pair_style) takes step - 1
+    touched_last = last_pass >= 0.0 ? last_pass : this_pass - 1.0;
   }
   inline void endPass(SurfacesIntersectData &, ForceData &, ForceData &) {}
 };

@@ -1,7 +1,8 @@
 """`stickslip bench`: performance figures, measured side by side in one run.
 
 Every figure is a median over repetitions; ratios compare runs made in the same
-process, one after the other. Engines with a module `stickslip/adapters/<engine>_bench.py`
+process, one after the other (LIGGGHTS' overhead: interleaved rounds, a geometric mean of
+the rounds' ratios with its 95 % interval, and callgrind's instruction counts). Engines with a module `stickslip/adapters/<engine>_bench.py`
 providing `benchmark(reps)` add their own rows (LIGGGHTS plugin overhead and MPI speed-up, YADE law
 cost per contact-step).
 """
@@ -231,14 +232,17 @@ def run_bench(out: Path, reps=3, engines=None, report=False):
         rows += engine_bench.benchmark(reps)
     if report:
         rows += report_rows()
-    fields = ["benchmark", "case", "contacts", "seconds_per_step", "contact_steps_per_s", "ratio_to_all_on", "value"]
+    fields = ["benchmark", "case", "contacts", "seconds_per_step", "contact_steps_per_s", "ratio_to_all_on", "value",
+              "ci_low", "ci_high"]
     with open(out / "bench.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
-    lines = ["# stickslip bench", "", f"Median of {reps} repetitions per figure; ratios measured in the same run.", "",
-             "| benchmark | case | contacts | s/step | contact-steps/s | ratio | value |",
-             "|---|---|---|---|---|---|---|"]
+    lines = ["# stickslip bench", "", f"Median of {reps} repetitions per figure; ratios measured in the same run "
+             "(LIGGGHTS' overhead: interleaved rounds, with the 95 % interval of the ratio; see "
+             "stickslip/adapters/liggghts_bench.py).", "",
+             "| benchmark | case | contacts | s/step | contact-steps/s | ratio | value | 95 % low | 95 % high |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append("| " + " | ".join(_fmt(r.get(k)) for k in fields) + " |")
     for e, why in missing.items():

@@ -1,34 +1,47 @@
 """LIGGGHTS rows for `stickslip bench`: what the stick_slip plugin costs, and how it scales.
 
-All figures come from one call, measured side by side on the same 3D packing of
-20 800 settled spheres (created once, cached under build/liggghts_bench/):
+All figures come from one call, measured on the same 3D packing of 20 800 settled spheres
+(~45 600 grain pair contacts; created once, cached under build/liggghts_bench/):
 
-1. plugin overhead: the same input script with `tangential stick_slip` (slips tested at
-   the end of the step, and with `exact_slip_timing on`) and with LIGGGHTS' stock
-   `tangential history` (hooke/stiffness, pair and floor), run alternately by the
-   plugin's launcher; time = LIGGGHTS' own "Loop time" of a fixed number of steps after
-   a short warm-up. Memory: history values per contact
-   (read from `compute pair/gran/local id history`'s column count) and the peak
-   RSS of each run.
+1. plugin overhead against LIGGGHTS' stock `tangential history` (hooke/stiffness, pair and
+   floor; the stock model from Debian's library, stick_slip in both slip timings from the
+   plugin; all run by the plugin's launcher), two ways:
+   - time, interleaved chunk by chunk: in each round the three configurations run side by
+     side as three processes, each stopped by a shell probe after its warm-up and after
+     every chunk of CHUNK steps; the benchmark lets one process go at a time, so a block
+     (the same chunk of each configuration, ~0.25 s each) is timed within a second, and
+     the order turns from block to block (A B C, B C A, C A B). A chunk's time is the
+     on-CPU time of LIGGGHTS' thread (/proc/PID/schedstat), and the probe also reads the
+     CPU the rest of the machine used meanwhile (/proc/stat). On this project's 2-core
+     virtual machine a busy second core slows a run by 20-90 % (measured: two runs side
+     by side took 1.5-1.9x their time alone), so a block counts as quiet only when other
+     processes used less than NOISY cores during each of its chunks; the figures use the
+     quiet blocks (all blocks, said so, when fewer than two are quiet), and more rounds run
+     while there are fewer than MIN_QUIET_BLOCKS. A ratio is the geometric mean of the
+     blocks' ratios with a 95 % interval from their log-ratios (stickslip/ratio_interval.py);
+   - instructions, counted by callgrind over CALLGRIND_STEPS steps after the same warm-up
+     (the same binaries and input: the count does not depend on the machine's load), in
+     total and in the tangential model alone, per configuration and as ratios.
+   Memory: history values per contact (read from `compute pair/gran/local id history`'s
+   column count) and the peak RSS of each run.
 2. MPI speed-up: the stick_slip script on 1 process (launcher) and on 2
-   (`mpirun -np 2` launcher), speed-up = T1/T2, and the contact statistics of both
+   (`mpirun -np 2` launcher), speed-up = T1/T2 (LIGGGHTS' "Loop time", medians of `reps`
+   runs alternating 1, 2, 2, 1, ...), and the contact statistics of both
    (`compute contact/atom` summed: pair contacts, mean coordination) to show they agree.
 
-Every time is a median over `reps` repetitions; the runs of one repetition follow
-each other (A, B, C, then C, B, A, ...) so slow drifts of the machine cancel. The
-timings need an otherwise idle machine: each run measures the CPU the rest of the
-machine used meanwhile (/proc/stat), a run disturbed by more than NOISY cores is
-re-run (within a budget of 2 x reps re-runs), and the worst remaining figure is a row.
+Cost on the 2-core machine, idle: ~40 s per round (5 by default), ~1 min of callgrind
+(two at a time; the warm-up runs uninstrumented), ~30 s per MPI repetition; ~2.5 min more to make the packing (40 000
+steps on 2 processes). On a busy machine everything is slower, and the rounds added for
+want of quiet blocks (up to 3 x) add to it.
 
-Cost on the 2-core reference machine: ~4.5 min for benchmark(3) with the packing cached,
-~2 min more to make it (40 000 steps on 2 processes).
-
-    python -m stickslip.adapters.liggghts_bench [--reps 3]
+    python -m stickslip.adapters.liggghts_bench [--rounds 5] [--reps 3] [--no-callgrind] [--baseline LAUNCHER]
 """
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import hashlib
+import math
 import os
 import re
 import shutil
@@ -39,12 +52,20 @@ import tempfile
 import time
 from pathlib import Path
 
+from .. import callgrind
+from ..ratio_interval import ratio_interval
 from .liggghts import BUILD, LAUNCHER
 
 CACHE = BUILD.parent / "liggghts_bench"
 
-STEPS = 3000  # timed steps per run (~20 s on one core of the reference machine)
 WARM = 200  # untimed steps first: contact histories build up again after read_data
+CHUNK = 50  # steps per timed chunk (~0.25 s on one idle core)
+CHUNKS = 40  # timed chunks per run (steps WARM to WARM + 2000)
+ROUNDS = 5  # rounds of the overhead comparison by default (~40 s each on the idle machine)
+NOISY = 0.1  # cores used by other processes during a chunk above which its block is not quiet
+MIN_QUIET_BLOCKS = 60  # quiet blocks wanted: more rounds (up to 3 x ROUNDS) until there are
+CALLGRIND_STEPS = 100  # steps counted by callgrind (after WARM; ~0.3 s a step under callgrind)
+MPI_STEPS = 2000  # timed steps of the MPI runs
 SETTLE = 40000  # steps of the one-off pour (0.2 s of gravity settling)
 
 # One material for every run: soft spheres (r = 0.8-1.0 mm, kn = 2000 N/m), dt ~ T_c/30.
@@ -94,7 +115,8 @@ run {settle}
 write_data {out}
 """
 
-# The timed script: identical for all configurations but for ${tang} and ${extra}.
+# The timed script: identical for all configurations but for ${tang} and ${extra}; {timed}
+# is the timed part (chunks with probes between them, or one run for callgrind or MPI).
 TIMED = HEADER + """\
 read_data {data}
 neighbor 0.0003 bin
@@ -111,9 +133,41 @@ compute cs all reduce sum c_c
 thermo_style custom step atoms c_cs
 thermo {warm}
 run {warm}
-thermo {steps}
-run {steps}
+{timed}"""
+
+# The probe between chunks: appends to probe.log the on-CPU and run-queue wait time (ns) of
+# LIGGGHTS' main thread (/proc/PID/schedstat; `shell` runs it from LIGGGHTS through sh, so
+# it looks for the launcher among its ancestors), the uptime (s) and the machine's CPU line
+# (/proc/stat), then waits until the benchmark writes a line into go.fifo. Shell built-ins
+# only: the probe itself should cost next to nothing.
+PROBE = """\
+#!/bin/sh
+p=$PPID
+while [ "$p" -gt 1 ]; do
+  read -r line < /proc/$p/stat
+  case "$line" in
+    *"(liggghts-stick"*)
+      read -r s < /proc/$p/schedstat; read -r u < /proc/uptime; read -r c < /proc/stat
+      echo "$s | $u | $c" >> probe.log
+      read -r go < go.fifo
+      exit 0;;
+  esac
+  set -- ${line##*) }
+  p=$2
+done
+exit 1
 """
+
+
+def _chunked(chunks, chunk):
+    """The timed part of an overhead run: chunks of `chunk` steps, a probe before each and
+    after the last (`pre no`: the chunks continue the same run, no re-setup between them)."""
+    return f"thermo {chunk}\nshell ./probe.sh\n" + f"run {chunk} pre no post no\nshell ./probe.sh\n" * chunks
+
+
+def _single(steps):
+    return f"thermo {steps}\nrun {steps}\n"
+
 
 # Two overlapping spheres, one step, and a local dump of `id history` with K columns:
 # LIGGGHTS refuses a column beyond the compute's count, so the largest K that runs
@@ -145,10 +199,14 @@ run 1
 # lines (fix wall/gran takes the settings last; "limitForce on" repeats one already there)
 TANGENTIAL = {"history": ("history", "limitForce on"), "stick_slip": ("stick_slip", "limitForce on"),
               "stick_slip_exact": ("stick_slip", "exact_slip_timing on")}
+OVERHEAD = ("history", "stick_slip", "stick_slip_exact")
+LABEL = {"history": "stock tangential history", "stick_slip": "tangential stick_slip",
+         "stick_slip_exact": "tangential stick_slip exact_slip_timing on"}
+TARGET = {"stick_slip": 1.02, "stick_slip_exact": 1.05}  # issue 32: at most this many times history's cost
 
-NOISY = 0.1  # cores used by other processes during a run above which it is re-run (within a budget)
-LAST_RUNS = {}  # (tangential model, processes) -> the runs behind the last benchmark() figures
-DISCARDED = []  # runs re-done because the machine was busy
+LAST_ROUNDS = []  # the overhead runs behind the last benchmark() figures: per round, {config: run}
+LAST_MPI = {}  # processes -> the MPI runs behind the last benchmark() figures
+LAST_COUNTS = {}  # config -> callgrind figures of the last benchmark()
 
 LOOP = re.compile(r"Loop time of (\S+) on (\d+) procs for (\d+) steps with (\d+) atoms")
 MEMORY = re.compile(r"Memory usage per processor = (\S+) Mbytes")
@@ -263,111 +321,294 @@ def _history_values(tang, extra, work):
     return best - 3
 
 
+def _command(tang, nproc=1, launcher=LAUNCHER):
+    model, extra = TANGENTIAL[tang]
+    cmd = [str(launcher), "-in", "in.timed", "-log", "none", "-var", "tang", model, "-var", "extra", extra]
+    return ["mpirun", "-np", str(nproc)] + cmd if nproc > 1 else cmd
+
+
+def _contacts_at(text, step, atoms):
+    """Pair contacts at `step` from its thermo line (step atoms c_cs; contact/atom summed
+    counts each pair contact twice)."""
+    last = [ln.split() for ln in text.splitlines() if re.match(rf"\s*{step}\s+{atoms}\s", ln)]
+    if not last:
+        raise RuntimeError(f"no thermo line for step {step}")
+    return float(last[-1][2]) / 2
+
+
+def _probe_chunks(log):
+    """Per chunk between two probes: on-CPU and run-queue wait time of LIGGGHTS' thread (s),
+    wall time (s) and the CPU the rest of the machine used meanwhile (cores)."""
+    tick = os.sysconf("SC_CLK_TCK")
+    marks = []
+    for line in Path(log).read_text().splitlines():
+        sched, up, cpu = line.split("|")
+        run_ns, wait_ns = (int(x) for x in sched.split()[:2])
+        ticks = [int(x) for x in cpu.split()[1:]]
+        busy = sum(ticks) - ticks[3] - (ticks[4] if len(ticks) > 4 else 0)  # all but idle and iowait
+        marks.append((run_ns * 1e-9, wait_ns * 1e-9, float(up.split()[0]), busy / tick))
+    chunks = []
+    for a, b in zip(marks, marks[1:]):
+        own, wall = b[0] - a[0], b[2] - a[2]
+        # uptime and /proc/stat count in 1/100 s: a 0.5 s chunk reads other processes' CPU to ~0.04 cores
+        foreign = max(0.0, (b[3] - a[3] - own) / wall) if wall > 0 else math.inf
+        chunks.append({"cpu": own, "wait": b[1] - a[1], "wall": wall, "foreign": foreign})
+    return chunks
+
+
+class _Paused:
+    """One LIGGGHTS run of the overhead comparison: CHUNKS chunks of CHUNK steps after WARM,
+    stopped at each probe until told to go on, so that the driver decides which
+    configuration runs when (the others wait, blocked, using no CPU)."""
+
+    def __init__(self, data, tang, launcher, d):
+        d.mkdir(exist_ok=True)
+        self.d = d
+        (d / "in.timed").write_text(TIMED.format(data=data, warm=WARM, timed=_chunked(CHUNKS, CHUNK)))
+        (d / "probe.sh").write_text(PROBE)
+        (d / "probe.sh").chmod(0o755)
+        for f in ("probe.log", "go.fifo"):
+            (d / f).unlink(missing_ok=True)
+        os.mkfifo(d / "go.fifo")
+        self.out = open(d / "stdout.txt", "w+", errors="replace")
+        self.p = subprocess.Popen(_command(tang, launcher=launcher), cwd=d, stdout=self.out,
+                                  stderr=subprocess.STDOUT, env=_env(), text=True)
+        self.probes = 0
+
+    def wait(self, timeout=3600):
+        """Until the run has reached its next probe (and stopped there)."""
+        t0 = time.monotonic()
+        log = self.d / "probe.log"
+        while not (log.is_file() and len(log.read_text().splitlines()) > self.probes):
+            if self.p.poll() is not None:
+                self._fail()
+            if time.monotonic() - t0 > timeout:
+                self.p.kill()
+                raise RuntimeError(f"no probe within {timeout} s in {self.d}")
+            time.sleep(0.01)  # (polling costs ~1 % of a core, counted as other processes' CPU)
+        self.probes += 1
+
+    def go(self):
+        with open(self.d / "go.fifo", "w") as f:
+            f.write("go\n")
+
+    def finish(self):
+        """Let the run end; its chunks (_probe_chunks), contacts, atoms and peak memory."""
+        rss = _vm_hwm_kib(self.p.pid) / 1024.0
+        self.go()
+        if self.p.wait() != 0:
+            self._fail()
+        self.out.seek(0)
+        text = self.out.read()
+        self.out.close()
+        chunks = _probe_chunks(self.d / "probe.log")
+        if len(chunks) != CHUNKS:
+            raise RuntimeError(f"{len(chunks)} of {CHUNKS} chunks timed in {self.d}")
+        atoms = int(LOOP.findall(text)[-1][3])
+        mem = MEMORY.findall(text)
+        return {"chunks": chunks, "atoms": atoms, "contacts": _contacts_at(text, WARM + CHUNKS * CHUNK, atoms),
+                "rss_mib": rss, "liggghts_mib": float(mem[-1]) if mem else None}
+
+    def _fail(self):
+        self.p.kill()
+        self.p.wait()
+        self.out.seek(0)
+        lines = self.out.read().strip().splitlines() or ["no output"]
+        why = next((x.strip() for x in lines if "ERROR" in x), lines[-1].strip())
+        raise RuntimeError(f"LIGGGHTS failed in {self.d}: {why} (the chunk probe needs /bin/sh and Linux's /proc)")
+
+
+def overhead_rounds(data, work, rounds, configs):
+    """`rounds` rounds; in each, one run per configuration ({name: (tangential key, launcher)}),
+    all started and stopped at their first probe, then advanced chunk by chunk in turn: a
+    block of chunks is the same chunk of every configuration, one right after the other
+    (~0.5 s each), and the order turns by one from block to block (A B C, B C A, C A B, ...)
+    so that each configuration takes each place equally often. Returns, per round,
+    {name: run} (_Paused.finish)."""
+    names = list(configs)
+    out = []
+    for r in range(rounds):
+        runs = {}
+        try:
+            for name in names:  # one at a time: set-ups and warm-ups do not overlap
+                tang, launcher = configs[name]
+                runs[name] = _Paused(data, tang, launcher, work / f"{name}-round{r}")
+                runs[name].wait()
+            for k in range(CHUNKS):
+                j = (r * CHUNKS + k) % len(names)
+                for name in names[j:] + names[:j]:
+                    runs[name].go()
+                    runs[name].wait()
+            got = {name: runs[name].finish() for name in names}
+        finally:
+            for run in runs.values():
+                if run.p.poll() is None:
+                    run.p.kill()
+                    run.p.wait()
+        out.append(got)
+        quiet = sum(_quiet_block(got, k) for k in range(CHUNKS))
+        print(f"  round {r + 1}/{rounds}: {quiet}/{CHUNKS} quiet blocks; other processes "
+              f"{statistics.fmean(c['foreign'] for g in got.values() for c in g['chunks']):.2f} cores", file=sys.stderr,
+              flush=True)
+    return out
+
+
+def _quiet_block(got, k):
+    return all(g["chunks"][k]["foreign"] <= NOISY for g in got.values())
+
+
+def _blocks(rounds_, quiet_only):
+    """The blocks (one chunk of each configuration, {name: CPU s per step}), all or quiet only."""
+    return [{n: g["chunks"][k]["cpu"] / CHUNK for n, g in got.items()} for got in rounds_ for k in range(CHUNKS)
+            if not quiet_only or _quiet_block(got, k)]
+
+
+def instruction_counts(data, work, configs, steps=CALLGRIND_STEPS):
+    """Callgrind's counts over `steps` steps after WARM, per configuration ({name: (tangential
+    key, launcher)}), two at a time: instructions per step, and those of the tangential model
+    (TangentialModel<id> and the stick_slip helpers; self costs) per step."""
+    def one(name):
+        tang, launcher = configs[name]
+        d = work / f"{name}-callgrind"
+        d.mkdir(exist_ok=True)
+        # instrumentation switched on after the warm-up: only the counted `run` is profiled
+        (d / "in.timed").write_text(TIMED.format(data=data, warm=WARM, timed="shell ./callgrind_on.sh\n" + _single(steps)))
+        parts = callgrind.count(_command(tang, launcher=launcher), d, env=_env(), on_request=True)
+        if len(parts) != 1:
+            raise RuntimeError(f"callgrind wrote {len(parts)} profiles in {d}, expected one (the counted run)")
+        costs = callgrind.self_costs(parts[0])
+        law = sum(v for f, v in costs.items()
+                  if "ContactModels::TangentialModel<" in f or "ContactModels::StickSlip::" in f)
+        text = (d / "callgrind.txt").read_text(errors="replace")
+        atoms = int(LOOP.findall(text)[-1][3])
+        return {"per_step": callgrind.total(parts[0]) / steps, "law_per_step": law / steps,
+                "contacts": _contacts_at(text, WARM + steps, atoms)}
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, os.cpu_count() or 1)) as ex:
+        return dict(zip(configs, ex.map(one, configs)))
+
+
 def _timed(data, tang, nproc, work):
-    """One timed run: seconds per step, pair contacts, atoms, peak RSS (MiB), LIGGGHTS' memory estimate."""
+    """One MPI-comparison run: LIGGGHTS' "Loop time" per step, pair contacts, atoms, peak RSS."""
     d = work / f"{tang}-np{nproc}"
     d.mkdir(exist_ok=True)
-    (d / "in.timed").write_text(TIMED.format(data=data, warm=WARM, steps=STEPS))
-    model, extra = TANGENTIAL[tang]
-    cmd = [str(LAUNCHER), "-in", "in.timed", "-log", "none", "-var", "tang", model, "-var", "extra", extra]
-    if nproc > 1:
-        cmd = ["mpirun", "-np", str(nproc)] + cmd
+    (d / "in.timed").write_text(TIMED.format(data=data, warm=WARM, timed=_single(MPI_STEPS)))
     info = {}
-    text, rss = _run(cmd, d, info=info)
+    text, rss = _run(_command(tang, nproc), d, info=info)
     loops = LOOP.findall(text)
     if len(loops) < 2:
         raise RuntimeError(f"no 'Loop time' line for the timed run ({tang}, {nproc} procs)")
     seconds, procs, steps, atoms = float(loops[-1][0]), int(loops[-1][1]), int(loops[-1][2]), int(loops[-1][3])
-    # the thermo line of the last step: step atoms c_cs (contact/atom summed = 2 x pair contacts)
-    last = [ln.split() for ln in text.splitlines() if re.match(rf"\s*{WARM + STEPS}\s+{atoms}\s", ln)]
-    contact_sum = float(last[-1][2])
-    mem = MEMORY.findall(text)
-    return {"s_per_step": seconds / steps, "procs": procs, "atoms": atoms, "contacts": contact_sum / 2,
-            "coordination": contact_sum / atoms, "rss_mib": rss, "liggghts_mib": float(mem[-1]) if mem else None,
-            "foreign_cores": info.get("foreign_cores")}
+    contacts = _contacts_at(text, WARM + MPI_STEPS, atoms)
+    return {"s_per_step": seconds / steps, "procs": procs, "atoms": atoms, "contacts": contacts,
+            "coordination": 2 * contacts / atoms, "rss_mib": rss, "foreign_cores": info.get("foreign_cores")}
 
 
-def benchmark(reps=3):
-    """Rows for `stickslip bench` (see the module docstring)."""
+def benchmark(reps=3, rounds=ROUNDS, counts=True, baseline=None):
+    """Rows for `stickslip bench` (see the module docstring). `baseline`: another build's
+    launcher, whose stick_slip (both timings) joins the rounds and the counts, for A/B
+    comparisons of two builds."""
     _check()
-    reps = max(1, int(reps))
-    DISCARDED.clear()
+    reps, rounds = max(1, int(reps)), max(1, int(rounds))
     data = _packing()
-    configs = [("history", 1), ("stick_slip", 1), ("stick_slip", 2), ("stick_slip_exact", 1)]
-    runs = {c: [] for c in configs}
+    configs = {name: (name, LAUNCHER) for name in OVERHEAD}
+    if baseline is not None:
+        configs.update({f"{name}@baseline": (name, Path(baseline)) for name in OVERHEAD[1:]})
+    rows = []
     with tempfile.TemporaryDirectory(prefix="liggghts_bench-") as work:
         work = Path(work)
         hist = {"history": _history_values("history", "", work),
                 "stick_slip": _history_values("stick_slip", "", work),
                 "stick_slip_record": _history_values("stick_slip", "stick_slip_record on", work)}
-        retries = 2 * reps  # budget for re-running runs disturbed by other processes
+        if counts and callgrind.available():
+            LAST_COUNTS.clear()
+            LAST_COUNTS.update(instruction_counts(data, work, configs))
+        LAST_ROUNDS[:] = overhead_rounds(data, work, rounds, configs)
+        # a busy machine leaves few quiet blocks: more rounds, within a limit
+        while len(_blocks(LAST_ROUNDS, True)) < MIN_QUIET_BLOCKS and len(LAST_ROUNDS) < 3 * rounds:
+            LAST_ROUNDS.extend(overhead_rounds(data, work, 1, configs))
+        mpi = {1: [], 2: []}
         for r in range(reps):
-            for c in (configs if r % 2 == 0 else configs[::-1]):
-                while True:
-                    got = _timed(data, c[0], c[1], work)
-                    busy = got["foreign_cores"] or 0.0
-                    if busy <= NOISY or retries <= 0:
-                        break
-                    retries -= 1
-                    DISCARDED.append((c, got))
-                runs[c].append(got)
-        LAST_RUNS.clear()
-        LAST_RUNS.update(runs)
-
-    def med(c, key):
-        return statistics.median(x[key] for x in runs[c])
-
-    A, B, M, E = configs
-    n = runs[B][0]["atoms"]
-    tag = f"{n} spheres, {STEPS} steps, median of {reps}"
-    rows = []
-    for c, label in ((A, "stock tangential history"), (B, "tangential stick_slip"),
-                     (E, "tangential stick_slip exact_slip_timing on")):
-        t, k = med(c, "s_per_step"), med(c, "contacts")
-        rows.append({"benchmark": "liggghts", "case": f"overhead: {label}, s per step (1 process; {tag})",
+            for nproc in ((1, 2) if r % 2 == 0 else (2, 1)):
+                mpi[nproc].append(_timed(data, "stick_slip", nproc, work))
+        LAST_MPI.clear()
+        LAST_MPI.update(mpi)
+    runs = LAST_ROUNDS
+    atoms = runs[0]["history"]["atoms"]
+    quiet, every = _blocks(runs, True), _blocks(runs, False)
+    blocks = quiet if len(quiet) >= 2 else every
+    which = f"{len(quiet)} quiet blocks" if blocks is quiet else f"all {len(every)} blocks (machine busy)"
+    tag = f"{atoms} spheres, median of {which} of {CHUNK} steps, {len(runs)} rounds"
+    for name in configs:
+        t = statistics.median(b[name] for b in blocks)
+        k = statistics.median(r[name]["contacts"] for r in runs)
+        rows.append({"benchmark": "liggghts", "case": f"overhead: {_label(name)}, CPU s per step (1 process; {tag})",
                      "contacts": round(k), "seconds_per_step": t, "contact_steps_per_s": k / t, "value": t})
-    ratio = med(B, "s_per_step") / med(A, "s_per_step")
-    paired = statistics.median(b["s_per_step"] / a["s_per_step"] for a, b in zip(runs[A], runs[B]))
-    rows.append({"benchmark": "liggghts", "case": "overhead: wall-time ratio stick_slip / history (target <= 1.05)",
-                 "value": ratio})
-    rows.append({"benchmark": "liggghts", "case": "overhead: median of the per-repetition ratios stick_slip / history",
-                 "value": paired})
-    rows.append({"benchmark": "liggghts", "case": "overhead: wall-time ratio stick_slip exact_slip_timing on / history "
-                 "(target <= 1.05)", "value": med(E, "s_per_step") / med(A, "s_per_step")})
-    rows.append({"benchmark": "liggghts", "case": "overhead: median of the per-repetition ratios stick_slip exact / history",
-                 "value": statistics.median(e["s_per_step"] / a["s_per_step"] for a, e in zip(runs[A], runs[E]))})
+    ratios = [(name, "history") for name in configs if name != "history"]
+    ratios.append(("stick_slip_exact", "stick_slip"))
+    if baseline is not None:
+        ratios += [(name, f"{name}@baseline") for name in OVERHEAD[1:]]
+    for num, den in ratios:
+        target = f" (target <= {TARGET[num]})" if den == "history" and num in TARGET else ""
+        for sel, label in ((blocks, which), (every, f"all {len(every)} blocks")):
+            mid, low, high = ratio_interval([(b[den], b[num]) for b in sel])
+            rows.append({"benchmark": "liggghts", "case": f"overhead: time {_label(num)} / {_label(den)}{target}, "
+                         f"geometric mean over {label}, 95 % interval", "value": mid, "ci_low": low, "ci_high": high})
+            if sel is every:
+                break
+    if LAST_COUNTS:
+        for name in configs:
+            c = LAST_COUNTS[name]
+            rows.append({"benchmark": "liggghts", "case": f"instructions per step, {_label(name)} "
+                         f"(callgrind, {CALLGRIND_STEPS} steps after {WARM})", "contacts": round(c["contacts"]),
+                         "value": c["per_step"]})
+            rows.append({"benchmark": "liggghts", "case": f"instructions in the tangential model per pair "
+                         f"contact-step (wall contacts' calls included), {_label(name)}", "value":
+                         c["law_per_step"] / c["contacts"]})
+        for num, den in ratios:
+            rows.append({"benchmark": "liggghts", "case": f"instructions: {_label(num)} / {_label(den)}",
+                         "value": LAST_COUNTS[num]["per_step"] / LAST_COUNTS[den]["per_step"]})
     for key, label in (("history", "stock tangential history"), ("stick_slip", "tangential stick_slip"),
                        ("stick_slip_record", "stick_slip with stick_slip_record on")):
         rows.append({"benchmark": "liggghts", "case": f"memory: history values per contact, {label}",
                      "value": float(hist[key])})
-    for c, label in ((A, "stock tangential history"), (B, "tangential stick_slip")):
-        rows.append({"benchmark": "liggghts", "case": f"memory: peak RSS of the run, MiB, {label}",
-                     "value": med(c, "rss_mib")})
-        if runs[c][0]["liggghts_mib"] is not None:
-            rows.append({"benchmark": "liggghts", "case": f"memory: LIGGGHTS' estimate per process, MiB, {label}",
-                         "value": runs[c][0]["liggghts_mib"]})
-    t1, t2 = med(B, "s_per_step"), med(M, "s_per_step")
-    for c, t, label in ((B, t1, "1 process (launcher)"), (M, t2, "2 processes (mpirun -np 2)")):
-        k = med(c, "contacts")
-        rows.append({"benchmark": "liggghts", "case": f"MPI: stick_slip, {label}, s per step ({tag})",
+    for name in ("history", "stick_slip"):
+        rows.append({"benchmark": "liggghts", "case": f"memory: peak RSS of the run, MiB, {_label(name)}",
+                     "value": statistics.median(r[name]["rss_mib"] for r in runs)})
+        if runs[0][name]["liggghts_mib"] is not None:
+            rows.append({"benchmark": "liggghts", "case": f"memory: LIGGGHTS' estimate per process, MiB, "
+                         f"{_label(name)}", "value": runs[0][name]["liggghts_mib"]})
+    t1, t2 = (statistics.median(x["s_per_step"] for x in mpi[n]) for n in (1, 2))
+    mtag = f"{atoms} spheres, {MPI_STEPS} steps, wall time, median of {reps}"
+    for n, t, label in ((1, t1, "1 process (launcher)"), (2, t2, "2 processes (mpirun -np 2)")):
+        k = statistics.median(x["contacts"] for x in mpi[n])
+        rows.append({"benchmark": "liggghts", "case": f"MPI: stick_slip, {label}, s per step ({mtag})",
                      "contacts": round(k), "seconds_per_step": t, "contact_steps_per_s": k / t, "value": t})
     rows.append({"benchmark": "liggghts", "case": "MPI: speed-up T1/T2 on 2 processes (target >= 1.6)",
                  "value": t1 / t2})
-    for c, label in ((B, "1 process"), (M, "2 processes")):
+    for n, label in ((1, "1 process"), (2, "2 processes")):
         rows.append({"benchmark": "liggghts",
                      "case": f"MPI: mean coordination (pair contacts per sphere, contact/atom) at the end, {label}",
-                     "contacts": round(med(c, "contacts")), "value": med(c, "coordination")})
-    k1, k2 = med(B, "contacts"), med(M, "contacts")
+                     "contacts": round(statistics.median(x["contacts"] for x in mpi[n])),
+                     "value": statistics.median(x["coordination"] for x in mpi[n])})
+    k1, k2 = (statistics.median(x["contacts"] for x in mpi[n]) for n in (1, 2))
     rows.append({"benchmark": "liggghts", "case": "MPI: relative difference in pair contacts, 2 vs 1 process",
                  "value": (k2 - k1) / k1})
-    # Timings mean something only on an otherwise idle machine: say how busy it was
-    # (runs above NOISY were re-run while the retry budget lasted).
-    foreign = [x["foreign_cores"] for c in configs for x in runs[c] if x["foreign_cores"] is not None]
+    # how busy the machine was: the overhead figures use quiet blocks when there are any; the
+    # MPI runs (wall time, both cores) are only as good as the machine was idle
+    chunks = [c for r in runs for g in r.values() for c in g["chunks"]]
+    rows.append({"benchmark": "liggghts", "case": f"machine: CPU used by other processes during the overhead "
+                 f"chunks, cores (median; {os.cpu_count()} cores; quiet: below {NOISY})",
+                 "value": statistics.median(c["foreign"] for c in chunks)})
+    foreign = [x["foreign_cores"] for n in mpi for x in mpi[n] if x["foreign_cores"] is not None]
     if foreign:
-        rows.append({"benchmark": "liggghts", "case": "machine: CPU used by other processes during the kept runs, "
-                     f"cores (max; {os.cpu_count()} cores; figures are unreliable above ~{NOISY})",
-                     "value": max(foreign)})
+        rows.append({"benchmark": "liggghts", "case": "machine: CPU used by other processes during the MPI runs, "
+                     f"cores (max; {os.cpu_count()} cores)", "value": max(foreign)})
     return rows
+
+
+def _label(name):
+    base, _, build = name.partition("@")
+    return LABEL[base] + (f" ({build} build)" if build else "")
 
 
 # What the two-process figure says about more machines; written under the table of bench.md.
@@ -385,30 +626,43 @@ for a layer)."""
 
 
 def _table(rows):
-    lines = [f"{'case':<100} {'contacts':>9} {'value':>12}"]
+    lines = [f"{'case':<120} {'contacts':>9} {'value':>12}  95 % interval"]
     for r in rows:
         c = "" if r.get("contacts") is None else str(r["contacts"])
-        lines.append(f"{r['case']:<100} {c:>9} {r['value']:>12.5g}")
+        ci = f"  [{r['ci_low']:.4f}, {r['ci_high']:.4f}]" if r.get("ci_low") is not None else ""
+        lines.append(f"{r['case']:<120} {c:>9} {r['value']:>12.5g}{ci}")
     return "\n".join(lines)
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="python -m stickslip.adapters.liggghts_bench",
-                                 description="LIGGGHTS stick_slip plugin: overhead vs stock history, MPI speed-up.")
-    ap.add_argument("--reps", type=int, default=3, help="repetitions per figure (median quoted)")
+                                 description="LIGGGHTS stick_slip plugin: overhead vs stock history (time in "
+                                             "interleaved rounds, callgrind instructions), MPI speed-up.")
+    ap.add_argument("--rounds", type=int, default=ROUNDS,
+                    help=f"overhead rounds (default {ROUNDS}; more, up to 3x, while quiet blocks are < {MIN_QUIET_BLOCKS})")
+    ap.add_argument("--reps", type=int, default=3, help="MPI repetitions (median quoted)")
+    ap.add_argument("--no-callgrind", action="store_true", help="skip the instruction counts")
+    ap.add_argument("--baseline", type=Path, help="another build's liggghts-stickslip, compared in the same rounds")
     a = ap.parse_args(argv)
+    if a.rounds < 1 or a.reps < 1:
+        ap.error("--rounds and --reps must be >= 1")
+    if a.baseline is not None and not a.baseline.is_file():
+        ap.error(f"--baseline {a.baseline}: no such file (a built liggghts-stickslip)")
     t0 = time.perf_counter()
     try:
-        rows = benchmark(a.reps)
+        rows = benchmark(a.reps, a.rounds, counts=not a.no_callgrind,
+                         baseline=a.baseline.resolve() if a.baseline else None)
     except RuntimeError as e:
         sys.stderr.write(f"liggghts_bench: {e}\n")
         return 1
     print(_table(rows))
-    print("\nruns (s per step, other processes' CPU in cores):")
-    for (tang, nproc), got in LAST_RUNS.items():
-        print(f"  {tang:<16} np={nproc}: " + ", ".join(f"{x['s_per_step']:.5f} ({x['foreign_cores'] or 0:.2f})" for x in got))
-    if DISCARDED:
-        print(f"  re-run because the machine was busy: {len(DISCARDED)} run(s)")
+    print(f"\nblocks (CPU ms per step of each configuration's chunk; other processes' CPU, cores, "
+          f"over the block; * quiet):")
+    for i, got in enumerate(LAST_ROUNDS):
+        for k in range(CHUNKS):
+            worst = max(g["chunks"][k]["foreign"] for g in got.values())
+            print(f"  {i + 1}.{k + 1:<3}" + " ".join(f"{g['chunks'][k]['cpu'] / CHUNK * 1e3:8.3f}" for g in got.values())
+                  + f"  {worst:5.2f}{' *' if _quiet_block(got, k) else ''}")
     print(f"\n({time.perf_counter() - t0:.0f} s)")
     return 0
 

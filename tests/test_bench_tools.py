@@ -1,0 +1,117 @@
+"""The benchmark's measuring tools (issue 32): the interval of a ratio measured in
+interleaved rounds, and the reading of callgrind's profiles. Cost: ~0.3 s in all."""
+import math
+
+import numpy as np
+import pytest
+
+from stickslip import callgrind
+from stickslip.ratio_interval import ratio_interval
+
+
+def test_ratio_interval_covers_the_true_ratio_95_times_in_100():
+    """2000 simulated benchmarks of 8 rounds: times with a common per-round disturbance
+    (cancels in the ratio) and independent log-normal scatter (sd 0.05) around a true
+    ratio 1.03. A 95 % interval must cover 1.03 in 95 % of them: the binomial scatter of
+    that share over 2000 trials is sqrt(0.95*0.05/2000) = 0.0049, so [0.935, 0.965] is
+    +-3 sd. A normal (z) interval on 8 rounds covers ~92 % and fails this; so does an
+    interval from the times' spread instead of the paired log-ratios."""
+    rng = np.random.default_rng(32)
+    true, n, trials = 1.03, 8, 2000
+    covered = 0
+    for _ in range(trials):
+        common = rng.uniform(0.7, 1.4, n)  # the machine's state in each round, shared by A and B
+        a = 5e-3 * common * np.exp(rng.normal(0.0, 0.05, n))
+        b = 5e-3 * true * common * np.exp(rng.normal(0.0, 0.05, n))
+        mid, low, high = ratio_interval(list(zip(a, b)))
+        assert low < mid < high
+        covered += low <= true <= high
+    assert 0.935 <= covered / trials <= 0.965
+
+
+def test_ratio_interval_is_the_geometric_mean_and_inverts():
+    pairs = [(1.0, 1.1), (2.0, 2.0), (1.0, 0.95)]
+    mid, low, high = ratio_interval(pairs)
+    # (1.1 * 1.0 * 0.95)^(1/3), to round-off (a few ulps of the logs' sum)
+    assert mid == pytest.approx((1.1 * 0.95) ** (1 / 3), rel=1e-14)
+    inv = ratio_interval([(b, a) for a, b in pairs])
+    assert inv[0] == pytest.approx(1 / mid, rel=1e-14)
+    assert inv[1] == pytest.approx(1 / high, rel=1e-14) and inv[2] == pytest.approx(1 / low, rel=1e-14)
+    one = ratio_interval([(1.0, 1.2)])
+    assert one[0] == pytest.approx(1.2, rel=1e-15) and math.isnan(one[1]) and math.isnan(one[2])
+
+
+# A profile as callgrind writes it (names compressed to (id) after their first use): main
+# costs 100 itself and calls f (inclusive 70: f's own 50 and g's 20, called from f).
+PROFILE = """\
+# callgrind format
+version: 1
+positions: line
+events: Ir
+summary: 170
+
+ob=(1) /bin/prog
+fl=(1) prog.c
+fn=(1) main
+3 60
+cfn=(2) f
+calls=1 10
+4 70
+5 40
+
+fn=(2)
+10 30
+cfn=(3) g(int)
+calls=2 20
+11 20
++1 20
+
+fn=(3)
+20 20
+"""
+
+
+def test_callgrind_self_costs_leave_out_what_a_function_calls(tmp_path):
+    p = tmp_path / "callgrind.out.1.1"
+    p.write_text(PROFILE)
+    assert callgrind.total(p) == 170
+    costs = callgrind.self_costs(p)
+    assert costs == {"main": 100, "f": 50, "g(int)": 20}
+    assert sum(costs.values()) == callgrind.total(p)
+
+
+def test_callgrind_total_refuses_a_file_without_summary(tmp_path):
+    p = tmp_path / "not-a-profile"
+    p.write_text("events: Ir\n")
+    with pytest.raises(RuntimeError, match="no summary"):
+        callgrind.total(p)
+
+
+# The same with one cost line per instruction (--dump-instr=yes: address, line, Ir), as the
+# path analysis reads it: f's instructions at 0x10, 0x14 (ran 5 times each), 0x18 (ran 2
+# times), the call at 0x1c (its line carries g's inclusive cost, not a run count).
+PROFILE_INSTR = """\
+# callgrind format
+version: 1
+positions: instr line
+events: Ir
+summary: 31
+
+fn=(1) f
+0x10 3 5
++4 3 5
++4 4 2
+cfn=(2) g
+calls=2 0x40 7
++4 5 10
+* 5 2
+fn=(2)
+0x40 7 7
+"""
+
+
+def test_callgrind_instruction_counts_read_each_instructions_runs(tmp_path):
+    p = tmp_path / "callgrind.out.1.1"
+    p.write_text(PROFILE_INSTR)
+    runs = callgrind.instruction_counts(p, lambda f: f == "f")
+    assert dict(runs) == {"f": {0x10: 5, 0x14: 5, 0x18: 2, 0x1C: 2}}
