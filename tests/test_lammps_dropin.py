@@ -34,9 +34,15 @@ DUMP = ("dump dropin all custom {every} dump.out id x y z vx vy vz fx fy fz omeg
         "dump_modify dropin sort id format float %.17g\n")
 
 
-def pour_script(n1, n2, every, newton):
-    """examples/pour/in.pour: the pour shortened to n1 steps, the chute to n2."""
+def pour_script(n1, n2, every, newton, damped=False):
+    """examples/pour/in.pour: the pour shortened to n1 steps, the chute to n2. damped: the
+    pair and the wall with tangential damping (dampflag 1, gamma_t = gamma_n/2) and
+    limit_damping, so that stock's rescale of a slipping contact's shear carries the
+    dashpot term (the example's dampflag 0 makes it vanish)."""
     s = (EXAMPLES / "pour" / "in.pour").read_text()
+    if damped:
+        s, k = re.subn(r"50\.0 NULL 0\.5 0\b", "50.0 NULL 0.5 1 limit_damping", s)
+        assert k == 2, "examples/pour/in.pour changed"
     s, k = re.subn(r"^newton\s+off$", f"newton {newton}", s, flags=re.M)
     runs = list(re.finditer(r"^run\s+25000$", s, flags=re.M))
     assert k == 1 and len(runs) == 2, "examples/pour/in.pour changed"
@@ -85,11 +91,12 @@ def assert_stock_and_ours_identical(tmp_path, script, np_, files=()):
 
 # cost (2-core machine, idle): serial ~1 s per run, 2 ranks ~3 s per run (MPI start-up);
 # two runs per case
-@pytest.mark.parametrize("np_,newton", [(1, "off"), (1, "on"), (2, "off"), (2, "on")])
-def test_pour_is_stock_bit_for_bit(tmp_path, np_, newton):
+@pytest.mark.parametrize("np_,newton,damped", [(1, "off", False), (1, "on", False), (2, "off", False),
+                                               (2, "on", False), (1, "off", True)])
+def test_pour_is_stock_bit_for_bit(tmp_path, np_, newton, damped):
     """examples/pour/in.pour, its first 5000 steps (402 then 804 grains; landing from step
-    ~2200) and the chute's set-up."""
-    assert_stock_and_ours_identical(tmp_path, pour_script(5000, 0, 1000, newton), np_)
+    ~2200) and the chute's set-up; also with tangential damping and limit_damping."""
+    assert_stock_and_ours_identical(tmp_path, pour_script(5000, 0, 1000, newton, damped), np_)
 
 
 def test_pour2d_is_stock_bit_for_bit(tmp_path):

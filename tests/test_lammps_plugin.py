@@ -161,28 +161,42 @@ def test_every_type_pair_has_its_own_coefficients(tmp_path):
     """Three types, six sliders (2D): a disk of type a dragged on a held disk of type b,
     one per type pair, each pair with its own mu_s and mu_k from pair_coeff (the
     pair_style's 0.5/0.45 used by none). Each saw-tooth must peak within one spring
-    increment below its own mu_s and drop to its own 2 mu_k - mu_s. ~0.5 s."""
+    increment below its own mu_s and drop to its own 2 mu_k - mu_s; the friction on the
+    slider opposes its motion and the slip count never falls, also after the contacts
+    have moved to the other body's neighbour list (second run). ~0.5 s."""
     coeffs = {(1, 1): (0.50, 0.45), (1, 2): (0.55, 0.50), (1, 3): (0.40, 0.32), (2, 2): (0.45, 0.40),
               (2, 3): (0.60, 0.52), (3, 3): (0.35, 0.30)}
     script = type_pairs_script(coeffs, "off")
     run_lammps(tmp_path, "pairs", script)
-    frames = read_dump(tmp_path / "dump.pairs")
-    steps = sorted(frames)[1:]
+    frames = read_pairs(tmp_path)
     p = DRAG
+    # per contact (its atom ids): type pair, Fn, tangential force on the slider along x,
+    # slip count, over steps 1..N (the record is the force on patom1; sliders have odd ids)
+    series = {}
+    for step in sorted(frames)[1:]:
+        for r in frames[step]:
+            ids = (int(min(r[0], r[1])), int(max(r[0], r[1])))
+            on_slider = r[5] if int(r[0]) % 2 == 1 else -r[5]
+            types = tuple(sorted((int(r[2]), int(r[3]))))
+            series.setdefault(ids, []).append((types, r[4], on_slider, np.hypot(r[5], r[6]), r[7]))
     seen = set()
-    for row in range(len(coeffs)):
-        a = np.array([frames[k][row] for k in steps])
-        key = tuple(sorted((int(a[0, 2]), int(a[0, 3]))))
+    for ids, rows in series.items():
+        assert len(rows) == p["steps"], ids
+        key = rows[0][0]
         seen.add(key)
         ms, mk = coeffs[key]
-        fn, fs, nslip = a[:, 4], np.hypot(a[:, 5], a[:, 6]), a[:, 7]
+        fn, fx, fs, nslip = (np.array([r[k] for r in rows]) for k in (1, 2, 3, 4))
         ratio = fs / fn
+        assert (fx < 0).all(), (key, "friction opposes the slider's motion along +x")
+        assert np.all(np.diff(nslip) >= 0), (key, "the slip count never falls")
         slip = np.diff(np.concatenate([[0.0], nslip])) > 0
         assert slip.sum() >= 3, (key, slip.sum())
         inc = p["ks"] * p["v"] * p["dt"] / fn.min()
         assert ms - inc <= ratio.max() < ms, (key, ratio.max())
         assert np.allclose(ratio[slip], 2 * mk - ms, rtol=1e-12, atol=0), key
     assert seen == set(coeffs)
+    held_first = [int(frames[k][0][0]) % 2 == 0 for k in (1199, 1201)]
+    assert held_first == [False, True], "the contacts must change lists (transfer_history)"
 
 
 def type_pairs_script(coeffs, newton, extra=""):
@@ -191,22 +205,29 @@ def type_pairs_script(coeffs, newton, extra=""):
     atoms, lines = [], []
     for k, (a, b) in enumerate(sorted(coeffs)):
         x = 0.01 * k
-        atoms.append(f"create_atoms {b} single {x} 0.0 0.0 units box")           # held
+        # the slider first: its neighbour list holds the contact until LAMMPS' spatial
+        # sort, switched on at the second run, puts the held disk (in a lower bin) first;
+        # the contact then moves to the held disk's list with its history seen from the
+        # other body (transfer_history)
         atoms.append(f"create_atoms {a} single {x} {rest!r} 0.0 units box")      # slider
+        atoms.append(f"create_atoms {b} single {x} 0.0 0.0 units box")           # held
     for (a, b), (ms, mk) in sorted(coeffs.items()):
         lines.append(f"pair_coeff {a} {b} mu_s {ms} mu_k {mk}")
     n = len(coeffs)
-    held = " ".join(str(2 * k + 1) for k in range(n))
+    held = " ".join(str(2 * k + 2) for k in range(n))
     return f"""units si
 dimension 2
 atom_style sphere
-atom_modify map array
+atom_modify map array sort 0 0.0
 boundary f f p
 newton {newton}
 comm_modify vel yes
 region box block -0.01 {0.01 * n} -0.01 0.01 -0.001 0.001 units box
 create_box 3 box
 neighbor 0.0005 bin
+# rebuild the lists every 50 steps: the contacts' histories pass through the history fix
+# (and, on 2 ranks, between the ranks) as they would in a flowing scene
+neigh_modify every 50 delay 0 check no
 {chr(10).join(atoms)}
 set group all diameter {2 * p['r']} mass {p['mass']!r}
 group held id {held}
@@ -217,14 +238,35 @@ timestep {p['dt']}
 fix grav slider gravity {p['g']} vector 0 -1 0
 fix mv slider move linear {p['v']} NULL NULL
 fix 2d all enforce2d
-compute pl all pair/local p11 p1 p2 p12 p13 cutoff radius
-compute ids all property/local patom1 patom2 ptype1 ptype2 cutoff radius
-dump d all local 1 dump.pairs c_ids[1] c_ids[2] c_ids[3] c_ids[4] c_pl[1] c_pl[2] c_pl[3] c_pl[4] c_pl[5]
-dump_modify d format float {F17}
 dump a all custom 100 dump.atoms id x y z vx vy vz fx fy fz
 dump_modify a sort id format float {F17}
-run {p['steps']}
+{record_dump(1)}
+run 1200
+atom_modify sort 1000 0.00225
+# (a compute pair/local made before atom_modify sort lists no pair afterwards in this
+# LAMMPS, stock styles too: the record is read through new ones)
+undump d1
+uncompute pl1
+uncompute ids1
+{record_dump(2)}
+run {p['steps'] - 1200}
 """
+
+
+def record_dump(k):
+    """Every contact's record, every step, into dump.pairs<k>."""
+    return f"""compute pl{k} all pair/local p11 p1 p2 p12 p13 cutoff radius
+compute ids{k} all property/local patom1 patom2 ptype1 ptype2 cutoff radius
+dump d{k} all local 1 dump.pairs{k} c_ids{k}[1] c_ids{k}[2] c_ids{k}[3] c_ids{k}[4] c_pl{k}[1] c_pl{k}[2] c_pl{k}[3] &
+  c_pl{k}[4] c_pl{k}[5]
+dump_modify d{k} format float {F17}"""
+
+
+def read_pairs(folder):
+    """The two record dumps of type_pairs_script, one dict by step."""
+    frames = read_dump(folder / "dump.pairs1")
+    frames.update(read_dump(folder / "dump.pairs2"))
+    return frames
 
 
 @pytest.mark.parametrize("law", ["", "slip_timing exact reset spring history_rotation keep_length lever_arm contact"])
@@ -240,7 +282,7 @@ def test_ranks_and_newton_do_not_change_a_few_grain_scene(tmp_path, law):
     for np_, newton in [(1, "off"), (2, "on"), (2, "off")]:
         d = tmp_path / f"{np_}{newton}"
         run_lammps(d, "pairs", type_pairs_script(coeffs, newton, law), np_=np_)
-        local = read_dump(d / "dump.pairs")
+        local = read_pairs(d)
         canon = {}
         for step, rows in local.items():
             out = []
