@@ -75,7 +75,8 @@ setup_lammps_headers() {
                 > /etc/apt/sources.list.d/stickslip-deb-src.sources
             apt-get update -qq
         fi
-        (cd "$cache" && apt-get source --download-only -qq "lammps=$version" >/dev/null)
+        # (as root apt would hand the download to its _apt user, which cannot write here)
+        (cd "$cache" && apt-get source --download-only -qq -o APT::Sandbox::User=root "lammps=$version" >/dev/null)
     fi
     rm -rf "$dir" && mkdir -p "$dir"
     tar -xJf "$cache"/lammps_*.orig.tar.xz -C "$dir" --strip-components=1 --wildcards \
