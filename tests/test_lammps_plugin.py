@@ -63,7 +63,7 @@ fix floor all wall/gran/stickslip hooke/history {coeffs} yplane 0.0 NULL {keywor
 fix grav all gravity {p['g']} vector 0 -1 0
 fix mv all move linear {p['v']} NULL NULL
 fix 2d all enforce2d
-dump d all custom 1 dump.drag id f_floor[9] f_floor[10] f_floor[11] f_floor[12] f_floor[13]
+dump d all custom 1 dump.drag id f_floor[9] f_floor[10] f_floor[11] f_floor[12] f_floor[13] f_floor[14]
 dump_modify d format float {F17}
 run {steps or p['steps']}
 """
@@ -78,22 +78,22 @@ pair_style gran/hooke/stickslip {coeffs} {keywords}
 pair_coeff * *
 fix grav slider gravity {p['g']} vector 0 0 -1
 fix mv slider move linear {p['v']} NULL NULL
-compute pl all pair/local p11 p1 p2 p3 p12 cutoff radius
+compute pl all pair/local p11 p1 p2 p3 p12 p13 cutoff radius
 compute ids all property/local patom1 patom2 cutoff radius
-dump d all local 1 dump.drag c_ids[1] c_pl[1] c_pl[2] c_pl[3] c_pl[4] c_pl[5]
+dump d all local 1 dump.drag c_ids[1] c_pl[1] c_pl[2] c_pl[3] c_pl[4] c_pl[5] c_pl[6]
 dump_modify d format float {F17}
 run {steps or p['steps']}
 """
 
 
 def drag_record(path, kind="wall2d"):
-    """The drag's dump -> (Fn, tangential force on the moved body (K, 3), slip count) over
-    steps 1..N (step 0 is the set-up: no time has passed)."""
+    """The drag's dump -> (Fn, tangential force on the moved body (K, 3), slip count,
+    dissipated work) over steps 1..N (step 0 is the set-up: no time has passed)."""
     frames = read_dump(path)
     rows = np.array([frames[k][0] for k in sorted(frames)])[1:]
     if kind == "pair3d" and rows[0, 0] == 1:  # the held sphere (id 1) is i: the record is the force on it
         rows[:, 2:5] *= -1
-    return rows[:, 1], rows[:, 2:5], rows[:, 5]
+    return rows[:, 1], rows[:, 2:5], rows[:, 5], rows[:, 6]
 
 
 # ---------------------------------------------------------------- the saw-tooth
@@ -116,9 +116,14 @@ def test_drag_sawtooth(tmp_path, kind, reset):
     - interval between slips: the force must rise by 2 (mu_s - mu_k) Fn at Ks V per
       second, T = 2 (mu_s - mu_k) Fn/(Ks V), less nu_s/Ks with reset spring (the dashpot's
       part comes back at once); steps quantise it by dt either way; the count follows.
-    - first slip: spring + dashpot reach mu_s Fn, Ks V t + nu_s V = mu_s Fn, within a step."""
+    - first slip: spring + dashpot reach mu_s Fn, Ks V t + nu_s V = mu_s Fn, within a step.
+    - dissipated work (docs/law.md "Energy"): a sticking step adds nu_s V^2 dt + Ks V^2 dt^2/2
+      (-F.V dt less the spring energy's increase, with F = -Ks D - nu_s V and D grown by
+      V dt); a slip step releases spring energy: more than that. The record differences
+      two spring energies ~Ks |D|^2 ~ 3e-9 J/m to get ~1e-14 J/m: round-off 1e-16 x 3e-9
+      per rounding, ~1e-9 of the increment; 1e-8 allowed (with the 3D tilt's theta^2)."""
     run_lammps(tmp_path, "drag", drag_script(kind, f"reset {reset}"))
-    fn, F, nslip = drag_record(tmp_path / "dump.drag", kind)
+    fn, F, nslip, work = drag_record(tmp_path / "dump.drag", kind)
     p = DRAG
     ks, nu, V, dt, ms, mk = p["ks"], p["nu_s"], p["v"], p["dt"], p["mu_s"], p["mu_k"]
     steps = np.arange(1, p["steps"] + 1)
@@ -155,6 +160,11 @@ def test_drag_sawtooth(tmp_path, kind, reset):
     assert 1 + int(np.floor(span / hi)) <= len(slip_steps) <= 1 + int(np.floor(span / lo))
     t1 = (ms * fn[first - 1] - nu * V) / (ks * V)
     assert abs(first * dt - t1) <= dt * (1 + 1e-9), (first, t1 / dt)
+
+    gained = np.diff(np.concatenate([[0.0], work]))
+    stick_gain = nu * V ** 2 * dt + ks * V ** 2 * dt ** 2 / 2
+    assert np.allclose(gained[~slip], stick_gain, rtol=1e-8 + theta ** 2, atol=0)
+    assert np.all(gained[slip] > stick_gain)
 
 
 def test_every_type_pair_has_its_own_coefficients(tmp_path):
@@ -426,7 +436,7 @@ def test_exact_timing_slips_inside_the_step(tmp_path, reset):
     and loads again for the rest of the step: |F_k| = Fmin + kept + rate (1 - theta).
     Sizes ~0.2 N, a handful of operations: round-off 1e-12 Fn. ~0.3 s."""
     run_lammps(tmp_path, "drag", drag_script("wall2d", f"slip_timing exact reset {reset}"))
-    fn, F, nslip = drag_record(tmp_path / "dump.drag")
+    fn, F, nslip, _ = drag_record(tmp_path / "dump.drag")
     p = DRAG
     rate = p["ks"] * p["v"] * p["dt"]
     kept = p["nu_s"] * p["v"] if reset == "spring" else 0.0
