@@ -15,9 +15,7 @@
 #include "neighbor.h"
 #include "update.h"
 
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 
 using namespace LAMMPS_NS;
@@ -37,22 +35,14 @@ struct Checker {
 
   [[noreturn]] void fail(const std::string &what) const { lmp->error->all(FLERR, cmd + ": " + what); }
 
-  double number(const char *name, const char *text, const char *allowed) const
+  double number(const std::string &name, const char *text, const char *allowed) const
   {
-    char *end = nullptr;
-    errno = 0;
-    const double v = std::strtod(text, &end);
-    if (end == text || *end != '\0' || errno || !std::isfinite(v))
-      fail(std::string(name) + " = '" + text + "' is not a number (allowed: " + allowed + ")");
-    return v;
+    return parse_number(lmp, cmd, name, text, allowed);
   }
 
-  void range(const char *name, double v, bool ok, const char *allowed) const
+  void range(const std::string &name, double v, bool ok, const char *allowed) const
   {
-    if (ok) return;
-    char msg[300];
-    snprintf(msg, sizeof msg, "%s = %g is outside its allowed range: %s", name, v, allowed);
-    fail(msg);
+    check_range(lmp, cmd, name, v, ok, allowed);
   }
 
   int axis(const char *keyword, const char *text) const
@@ -104,8 +94,8 @@ WallArguments::WallArguments(LAMMPS *lmp, int narg, char **arg)
     wallstyle = style[0] - 'x';
     if (iarg + 3 > narg) check.fail(style + " needs lo hi (a number or NULL each)");
     const bool has_lo = strcmp(arg[iarg + 1], "NULL") != 0, has_hi = strcmp(arg[iarg + 2], "NULL") != 0;
-    const double lo = has_lo ? check.number((style + " lo").c_str(), arg[iarg + 1], "a number or NULL") : 0.0;
-    const double hi = has_hi ? check.number((style + " hi").c_str(), arg[iarg + 2], "a number or NULL") : 0.0;
+    const double lo = has_lo ? check.number(style + " lo", arg[iarg + 1], "a number or NULL") : 0.0;
+    const double hi = has_hi ? check.number(style + " hi", arg[iarg + 2], "a number or NULL") : 0.0;
     if (has_lo && has_hi && !(lo < hi)) check.fail(style + " lo must be below hi (or NULL)");
     if (!has_lo && !has_hi) check.fail(style + " needs lo or hi (both NULL is no wall)");
     if (two_d && wallstyle == ZPLANE)

@@ -33,25 +33,6 @@ namespace {
 
 const std::string CMD = std::string("pair_style ") + PairGranHookeStickSlip::STYLE;
 
-// a number argument, or one error line naming it and its allowed range
-double number(LAMMPS *lmp, const std::string &cmd, const char *name, const char *text, const char *allowed)
-{
-  char *end = nullptr;
-  errno = 0;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || errno || !std::isfinite(v))
-    lmp->error->all(FLERR, cmd + ": " + name + " = '" + text + "' is not a number (allowed: " + allowed + ")");
-  return v;
-}
-
-void check_range(LAMMPS *lmp, const std::string &cmd, const char *name, double v, bool ok, const char *allowed)
-{
-  if (ok) return;
-  char msg[300];
-  snprintf(msg, sizeof msg, ": %s = %g is outside its allowed range: %s", name, v, allowed);
-  lmp->error->all(FLERR, cmd + msg);
-}
-
 }  // namespace
 
 PairGranHookeStickSlip::PairGranHookeStickSlip(LAMMPS *lmp) :
@@ -89,21 +70,21 @@ void PairGranHookeStickSlip::settings(int narg, char **arg)
   if (narg < 6)
     error->all(FLERR, CMD + ": needs Kn Kt gamma_n gamma_t xmu dampflag [limit_damping] [keyword value ...], got " +
                           std::to_string(narg) + " arguments");
-  kn = number(lmp, CMD, "Kn", arg[0], "Kn > 0");
+  kn = parse_number(lmp, CMD, "Kn", arg[0], "Kn > 0");
   check_range(lmp, CMD, "Kn", kn, kn > 0.0, "Kn > 0");
   if (strcmp(arg[1], "NULL") == 0)
     kt = kn * 2.0 / 7.0;  // stock's default
   else
-    kt = number(lmp, CMD, "Kt", arg[1], "Kt > 0 or NULL");
+    kt = parse_number(lmp, CMD, "Kt", arg[1], "Kt > 0 or NULL");
   check_range(lmp, CMD, "Kt", kt, kt > 0.0, "Kt > 0 (or NULL: 2/7 Kn)");
-  gamman = number(lmp, CMD, "gamma_n", arg[2], "gamma_n >= 0");
+  gamman = parse_number(lmp, CMD, "gamma_n", arg[2], "gamma_n >= 0");
   check_range(lmp, CMD, "gamma_n", gamman, gamman >= 0.0, "gamma_n >= 0");
   if (strcmp(arg[3], "NULL") == 0)
     gammat = 0.5 * gamman;  // stock's default
   else
-    gammat = number(lmp, CMD, "gamma_t", arg[3], "gamma_t >= 0 or NULL");
+    gammat = parse_number(lmp, CMD, "gamma_t", arg[3], "gamma_t >= 0 or NULL");
   check_range(lmp, CMD, "gamma_t", gammat, gammat >= 0.0, "gamma_t >= 0 (or NULL: gamma_n/2)");
-  xmu = number(lmp, CMD, "xmu", arg[4], "0 <= xmu <= 10000");
+  xmu = parse_number(lmp, CMD, "xmu", arg[4], "0 <= xmu <= 10000");
   check_range(lmp, CMD, "xmu (mu_s)", xmu, xmu >= 0.0 && xmu <= 10000.0, "0 <= xmu <= 10000 (stock's range)");
   if (strcmp(arg[5], "0") == 0)
     dampflag = 0;
@@ -150,7 +131,7 @@ void PairGranHookeStickSlip::coeff(int narg, char **arg)
     if (key != "mu_s" && key != "mu_k")
       error->all(FLERR, cmd + ": unknown keyword '" + key + "' (allowed: mu_s, mu_k)");
     if (iarg + 1 >= narg) error->all(FLERR, cmd + ": keyword " + key + " needs a value");
-    const double v = number(lmp, cmd, key.c_str(), arg[iarg + 1], key == "mu_s" ? "0 <= mu_s <= 10000" : ">= 0");
+    const double v = parse_number(lmp, cmd, key, arg[iarg + 1], key == "mu_s" ? "0 <= mu_s <= 10000" : ">= 0");
     if (key == "mu_s") {
       check_range(lmp, cmd, "mu_s", v, v >= 0.0 && v <= 10000.0, "0 <= mu_s <= 10000");
       ms = v;
@@ -227,12 +208,8 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
     comm->forward_comm_pair(this);
   }
 
-  double **x = atom->x, **v = atom->v, **f = atom->f;
-  double **omega = atom->omega, **torque = atom->torque;
-  const double *radius = atom->radius, *rmass = atom->rmass;
-  const int *mask = atom->mask, *type = atom->type;
-  const int nlocal = atom->nlocal;
-  const int newton_pair = force->newton_pair;
+  double **x = atom->x;
+  const double *radius = atom->radius;
   const int dnum = size_history;
 
   const int inum = list->inum;
@@ -245,7 +222,6 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
     const int i = ilist[ii];
     const double xi = x[i][0], yi = x[i][1], zi = x[i][2];
     const double radi = radius[i];
-    const int itype = type[i];
     int *touch = firsttouch[i];
     double *allhist = firsthist[i];
     const int *jlist = firstneigh[i];
@@ -262,74 +238,94 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
       if (rsq >= radsum * radsum) {
         // apart: the contact has ended, its history is dropped (docs/law.md step 3)
         touch[jj] = 0;
-        for (int m = 0; m < dnum; m++) hist[m] = 0.0;
+        hist[0] = hist[1] = hist[2] = 0.0;
+        if (dnum > SIZE_PLAIN)
+          for (int m = SIZE_PLAIN; m < dnum; m++) hist[m] = 0.0;
         continue;
       }
-      const double r = sqrt(rsq);
-      const double rinv = 1.0 / r;
-      const double rsqinv = 1.0 / rsq;
-
-      // relative translational velocity, its normal and tangential parts
-      const double vr1 = v[i][0] - v[j][0], vr2 = v[i][1] - v[j][1], vr3 = v[i][2] - v[j][2];
-      const double vnnr = vr1 * del[0] + vr2 * del[1] + vr3 * del[2];
-      const double vn1 = del[0] * vnnr * rsqinv, vn2 = del[1] * vnnr * rsqinv, vn3 = del[2] * vnnr * rsqinv;
-      const double vt1 = vr1 - vn1, vt2 = vr2 - vn2, vt3 = vr3 - vn3;
-
-      // rotation: lever arms to the contact (radii, or c = r - delta/2)
-      const double ci = lever(law, radi, radsum - r), cj = lever(law, radj, radsum - r);
-      const double wr1 = (ci * omega[i][0] + cj * omega[j][0]) * rinv;
-      const double wr2 = (ci * omega[i][1] + cj * omega[j][1]) * rinv;
-      const double wr3 = (ci * omega[i][2] + cj * omega[j][2]) * rinv;
-
-      // damping per unit mass times the pair's effective mass (stock), or absolute
-      double meff = 1.0;
-      if (!law.absolute) {
-        double mi = rmass[i], mj = rmass[j];
-        if (fix_rigid) {
-          if (mass_rigid[i] > 0.0) mi = mass_rigid[i];
-          if (mass_rigid[j] > 0.0) mj = mass_rigid[j];
-        }
-        meff = mi * mj / (mi + mj);
-        if (mask[i] & freeze_group_bit) meff = mj;
-        if (mask[j] & freeze_group_bit) meff = mi;
-      }
-
-      // normal force (eq. 3): Fn = ccel * r along del
-      const double damp = meff * gamman * vnnr * rsqinv;
-      double ccel = kn * (radsum - r) * rinv - damp;
-      if (limit_damping && (ccel < 0.0)) ccel = 0.0;
-
-      // V_s (eq. 6): tangential velocity of i's contact point relative to j's
-      const double vtr[3] = {vt1 - (del[2] * wr2 - del[1] * wr3), vt2 - (del[0] * wr3 - del[2] * wr1),
-                             vt3 - (del[1] * wr1 - del[0] * wr2)};
-
       touch[jj] = 1;
-      double fs[3];
-      tangential_force(law, coeffs[itype][type[j]], del, rsqinv, ccel * r, vtr, meff * gammat, dt, stepping, hist, fs);
-
-      // forces and torques (docs/law.md step 6)
-      const double fx = del[0] * ccel + fs[0], fy = del[1] * ccel + fs[1], fz = del[2] * ccel + fs[2];
-      f[i][0] += fx;
-      f[i][1] += fy;
-      f[i][2] += fz;
-      const double tor1 = rinv * (del[1] * fs[2] - del[2] * fs[1]);
-      const double tor2 = rinv * (del[2] * fs[0] - del[0] * fs[2]);
-      const double tor3 = rinv * (del[0] * fs[1] - del[1] * fs[0]);
-      torque[i][0] -= ci * tor1;
-      torque[i][1] -= ci * tor2;
-      torque[i][2] -= ci * tor3;
-      if (newton_pair || j < nlocal) {
-        f[j][0] -= fx;
-        f[j][1] -= fy;
-        f[j][2] -= fz;
-        torque[j][0] -= cj * tor1;
-        torque[j][1] -= cj * tor2;
-        torque[j][2] -= cj * tor3;
-      }
-      if (evflag) ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, fx, fy, fz, del[0], del[1], del[2]);
+      contact(i, j, del, rsq, radi, radj, hist, stepping);
     }
   }
   if (vflag_fdotr) virial_fdotr_compute();
+}
+
+/* One touching grain pair (docs/law.md steps 1-6): the normal force and relative velocity
+   as stock computes them, the tangential force from the law, forces and torques on both.
+   del = x_i - x_j, rsq = |del|^2. (Out of line: the loop over neighbours, most of them not
+   touching, keeps its few values in registers.) */
+void PairGranHookeStickSlip::contact(int i, int j, const double *del, double rsq, double radi, double radj,
+                                     double *hist, bool stepping)
+{
+  double **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
+  const double *rmass = atom->rmass;
+  const int *mask = atom->mask, *type = atom->type;
+  const int nlocal = atom->nlocal;
+  const int newton_pair = force->newton_pair;
+  const double radsum = radi + radj;
+  const double r = sqrt(rsq);
+  const double rinv = 1.0 / r;
+  const double rsqinv = 1.0 / rsq;
+
+  // relative translational velocity, its normal and tangential parts
+  const double vr1 = v[i][0] - v[j][0], vr2 = v[i][1] - v[j][1], vr3 = v[i][2] - v[j][2];
+  const double vnnr = vr1 * del[0] + vr2 * del[1] + vr3 * del[2];
+  const double vn1 = del[0] * vnnr * rsqinv, vn2 = del[1] * vnnr * rsqinv, vn3 = del[2] * vnnr * rsqinv;
+  const double vt1 = vr1 - vn1, vt2 = vr2 - vn2, vt3 = vr3 - vn3;
+
+  // rotation: lever arms to the contact (radii, or c = r - delta/2)
+  const double ci = lever(law, radi, radsum - r), cj = lever(law, radj, radsum - r);
+  const double wr1 = (ci * omega[i][0] + cj * omega[j][0]) * rinv;
+  const double wr2 = (ci * omega[i][1] + cj * omega[j][1]) * rinv;
+  const double wr3 = (ci * omega[i][2] + cj * omega[j][2]) * rinv;
+
+  // damping per unit mass times the pair's effective mass (stock), or absolute
+  double meff = 1.0;
+  if (!law.absolute) {
+    double mi = rmass[i], mj = rmass[j];
+    if (fix_rigid) {
+      if (mass_rigid[i] > 0.0) mi = mass_rigid[i];
+      if (mass_rigid[j] > 0.0) mj = mass_rigid[j];
+    }
+    meff = mi * mj / (mi + mj);
+    if (mask[i] & freeze_group_bit) meff = mj;
+    if (mask[j] & freeze_group_bit) meff = mi;
+  }
+
+  // normal force (eq. 3): Fn = ccel * r along del
+  const double damp = meff * gamman * vnnr * rsqinv;
+  double ccel = kn * (radsum - r) * rinv - damp;
+  if (limit_damping && (ccel < 0.0)) ccel = 0.0;
+
+  // V_s (eq. 6): tangential velocity of i's contact point relative to j's
+  const double vtr[3] = {vt1 - (del[2] * wr2 - del[1] * wr3), vt2 - (del[0] * wr3 - del[2] * wr1),
+                         vt3 - (del[1] * wr1 - del[0] * wr2)};
+
+  double fs[3];
+  // (the type pair's coefficients looked up here, in the touching contacts only)
+  tangential_force(law, coeffs[type[i]][type[j]], del, rsqinv, ccel * r, vtr, meff * gammat, dt, stepping, hist,
+                   fs);
+
+  // forces and torques (docs/law.md step 6)
+  const double fx = del[0] * ccel + fs[0], fy = del[1] * ccel + fs[1], fz = del[2] * ccel + fs[2];
+  f[i][0] += fx;
+  f[i][1] += fy;
+  f[i][2] += fz;
+  const double tor1 = rinv * (del[1] * fs[2] - del[2] * fs[1]);
+  const double tor2 = rinv * (del[2] * fs[0] - del[0] * fs[2]);
+  const double tor3 = rinv * (del[0] * fs[1] - del[1] * fs[0]);
+  torque[i][0] -= ci * tor1;
+  torque[i][1] -= ci * tor2;
+  torque[i][2] -= ci * tor3;
+  if (newton_pair || j < nlocal) {
+    f[j][0] -= fx;
+    f[j][1] -= fy;
+    f[j][2] -= fz;
+    torque[j][0] -= cj * tor1;
+    torque[j][1] -= cj * tor2;
+    torque[j][2] -= cj * tor3;
+  }
+  if (evflag) ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, fx, fy, fz, del[0], del[1], del[2]);
 }
 
 /* ----------------------------------------------------------------------

@@ -51,6 +51,28 @@ struct Settings {
   int history_size() const { return record ? SIZE_RECORD : SIZE_PLAIN; }
 };
 
+/* A number argument, or one error line naming it and its allowed range. */
+inline double parse_number(LAMMPS_NS::LAMMPS *lmp, const std::string &cmd, const std::string &name, const char *text,
+                           const char *allowed)
+{
+  char *end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || errno || !std::isfinite(v))
+    lmp->error->all(FLERR, cmd + ": " + name + " = '" + text + "' is not a number (allowed: " + allowed + ")");
+  return v;
+}
+
+/* One error line when a value is outside its allowed range. */
+inline void check_range(LAMMPS_NS::LAMMPS *lmp, const std::string &cmd, const std::string &name, double v, bool ok,
+                        const char *allowed)
+{
+  if (ok) return;
+  char value[40];
+  snprintf(value, sizeof value, "%g", v);
+  lmp->error->all(FLERR, cmd + ": " + name + " = " + value + " is outside its allowed range: " + allowed);
+}
+
 /* Reads one of the law's keywords at arg[iarg] into s. Returns the number of words used;
    0 if arg[iarg] is not a law keyword. Errors name the command, the keyword and the
    allowed values. */
@@ -71,14 +93,8 @@ inline int parse_keyword(LAMMPS_NS::LAMMPS *lmp, const std::string &cmd, Setting
   const std::string key = arg[iarg];
   if (key == "mu_k") {
     if (iarg + 1 >= narg) lmp->error->all(FLERR, cmd + ": keyword mu_k needs a value (mu_s/2 <= mu_k <= mu_s)");
-    s.mu_k = -1.0;
-    const char *text = arg[iarg + 1];
-    char *end = nullptr;
-    errno = 0;
-    const double v = std::strtod(text, &end);
-    if (end == text || *end != '\0' || errno || !std::isfinite(v) || v < 0.0)
-      lmp->error->all(FLERR, cmd + ": mu_k = '" + text + "' is not a number >= 0 (allowed: mu_s/2 <= mu_k <= mu_s)");
-    s.mu_k = v;
+    s.mu_k = parse_number(lmp, cmd, "mu_k", arg[iarg + 1], "mu_s/2 <= mu_k <= mu_s");
+    check_range(lmp, cmd, "mu_k", s.mu_k, s.mu_k >= 0.0, "mu_s/2 <= mu_k <= mu_s");
     return 2;
   }
   for (const Choice &c : choices) {
@@ -178,9 +194,13 @@ __attribute__((noinline)) inline double exact_step(const Settings &s, const Coef
    vtr = V_s (eq. 6), the velocity of i's contact point relative to j's; nu_s: the
    tangential damping (meff * gamma_t, or gamma_t with damping absolute);
    update: a step (false: a set-up evaluation, no time passes and D is not loaded);
-   hist: the contact's history (layout above). Out: fs, the tangential force on i. */
-inline void tangential_force(const Settings &s, const Coeffs &c, const double *del, double rsqinv, double ccel_r,
-                             const double *vtr, double nu_s, double dt, bool update, double *hist, double *fs)
+   hist: the contact's history (layout above). Out: fs, the tangential force on i.
+   (Always inlined: it runs for every contact of every step, and a call would cost the
+   caller's registers; the rare paths it calls are out of line.) */
+__attribute__((always_inline)) inline void tangential_force(const Settings &s, const Coeffs &c, const double *del,
+                                                            double rsqinv, double ccel_r, const double *vtr,
+                                                            double nu_s, double dt, bool update, double *hist,
+                                                            double *fs)
 {
   const double kt = c.kt;
   double D[3] = {hist[0], hist[1], hist[2]};
