@@ -12,6 +12,7 @@
    loaded (the stock lmp with stickslip.lmp, the python module) gets them from
    stickslip_lammps_register(). */
 
+#include "fix_wall_gran_region_stickslip.h"
 #include "fix_wall_gran_stickslip.h"
 #include "pair_gran_hooke_stickslip.h"
 
@@ -32,9 +33,18 @@ Pair *make_pair(LAMMPS *lmp) { return new StickSlip::PairGranHookeStickSlip(lmp)
 
 Fix *make_wall(LAMMPS *lmp, int narg, char **arg) { return new StickSlip::FixWallGranStickSlip(lmp, narg, arg); }
 
+Fix *make_region_wall(LAMMPS *lmp, int narg, char **arg)
+{
+  return new StickSlip::FixWallGranRegionStickSlip(lmp, narg, arg);
+}
+
 void add_styles(Force *force) { (*force->pair_map)[StickSlip::PairGranHookeStickSlip::STYLE] = &make_pair; }
 
-void add_styles(Modify *modify) { (*modify->fix_map)[StickSlip::FixWallGranStickSlip::STYLE] = &make_wall; }
+void add_styles(Modify *modify)
+{
+  (*modify->fix_map)[StickSlip::FixWallGranStickSlip::STYLE] = &make_wall;
+  (*modify->fix_map)[StickSlip::FixWallGranRegionStickSlip::STYLE] = &make_region_wall;
+}
 
 // LAMMPS' own functions (member functions: `this` is the first argument in the C++ ABI)
 void (*force_factories)(Force *) = nullptr;
