@@ -123,6 +123,24 @@ def test_tray_is_pyrefs_twin(tmp_path, timing):
 
 
 @needs_lammps
+def test_3d_oblique_plane_exact_timing_is_pyrefs_twin(tmp_path):
+    """3D: a sphere launched across a plane inclined by tan(beta) = 0.3 (a still region
+    plane on LAMMPS), exact slip timing, sliding with the dashpot above its threshold while
+    gravity turns V_s (tests/test_liggghts_engine.py's incline, regime dashpot_slide: every
+    slipping step slides at Fmin along -V_s after its first slip, E4), every row within
+    round-off of pyref's. ~1 s on LAMMPS, ~3 s on pyref."""
+    from conftest import run_pyref
+    from test_liggghts_engine import incline_scene
+
+    sc = incline_scene(0.45, 0.1, v0=0.05, duration=0.03)
+    dl = lammps_adapter.run(sc, tmp_path).timeseries
+    assert "region r0 plane" in (tmp_path / "lammps" / "in.scene").read_text()
+    dp, _ = run_pyref(sc)
+    assert_pyrefs_twin(sc, dl, dp)
+    assert dl["g-plane_slip"].sum() > 500
+
+
+@needs_lammps
 def test_one_and_two_ranks_are_identical(tmp_path):
     """The few-grain scenes on 1 and 2 MPI ranks give the same bits: each grain has at most
     one pair contact, so no force is summed in another order when a pair straddles the

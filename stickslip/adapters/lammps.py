@@ -13,9 +13,10 @@ Walls: a fixed plane normal to an axis is a primitive wall (`fix wall/gran/stick
 xplane|yplane|zplane`), one sliding along itself along an axis the same with `shear`; any
 other plane is a region plane (`fix wall/gran/region/stickslip`), turned by `region ...
 rotate v_theta` (the angle of each step is the scene's, Scene.rotation_steps and
-rotation_rate) or moved by `region ... move`. LAMMPS' region gives each contact the wall's
-rigid velocity of the step at the surface point nearest the grain's centre (docs/law.md
-step 1), by differencing its angle and place over the step.
+rotation_rate) or moved by `region ... move` (no velocity in the set-up: the run's notes
+say so). LAMMPS' region gives each contact the wall's rigid velocity of the step at the
+surface point nearest the grain's centre (docs/law.md step 1), by differencing its angle
+and place over the step.
 """
 from __future__ import annotations
 
@@ -121,7 +122,8 @@ class _Script:
         nu_n = c.nu_n if eff["normal_damping"] else 0.0
         nu_s = c.nu_s if eff["tangential_damping"] else 0.0
         # limit_damping: no attractive normal force (docs/law.md step 2, Fn = max(0, ...))
-        args = f"{_fmt(c.kn)} {_fmt(c.ks)} {_fmt(nu_n)} {_fmt(nu_s)} {_fmt(c.mu_s)} {1 if nu_s > 0 else 0} limit_damping"
+        dampflag = 1 if nu_s > 0 else 0
+        args = f"{_fmt(c.kn)} {_fmt(c.ks)} {_fmt(nu_n)} {_fmt(nu_s)} {_fmt(c.mu_s)} {dampflag} limit_damping"
         keywords = f"mu_k {_fmt(c.mu_k)} reset {c.reset} slip_timing {c.slip_timing} {LAW_KEYWORDS}"
         return args, keywords
 
@@ -166,8 +168,8 @@ class _Script:
             if g.imposed and not g.fixed:
                 held.setdefault("".join(sorted(g.imposed)), []).append(self.ids[g.name])
         for comps, ids in held.items():
-            self.add(f"group hold_{comps} id {id_ranges(ids)}",
-                     f"fix hold_{comps} hold_{comps} setforce " + " ".join("0.0" if c in comps else "NULL" for c in "xyz"))
+            zero = " ".join("0.0" if c in comps else "NULL" for c in "xyz")
+            self.add(f"group hold_{comps} id {id_ranges(ids)}", f"fix hold_{comps} hold_{comps} setforce {zero}")
         if d2:
             self.add("fix twod all enforce2d")
         self._output()
@@ -203,9 +205,8 @@ class _Script:
             for a, name in enumerate(moves):
                 self.add(f"variable {name[2:]} equal {_fmt(v[a])}*step*{_fmt(sc.dt)}")
             region += " move " + " ".join(moves)
-            if np.any(v @ w.normal):
-                self.notes.append(f"wall {w.name} moves across its plane: LAMMPS gives a moving region no velocity in "
-                                  "the set-up force evaluation (pyref: its velocity), so the first half step differs")
+            self.notes.append(f"wall {w.name} moves as a LAMMPS region, which has no velocity in the set-up force "
+                              "evaluation (pyref: the wall's velocity): the first half step differs if it touches a grain")
         self.add(region, f"fix {fid} all wall/gran/region/stickslip hooke/history {args} region r{k} {keywords}")
 
     def _gravity(self):
@@ -359,7 +360,8 @@ def _timeseries(script, work):
     if bad.any():
         r, c = np.argwhere(bad)[0]
         raise RuntimeError(f"LAMMPS produced non-finite values: {df.columns[c]} = {df.iat[r, c]} at t = "
-                           f"{df['t'].iat[r]:.6g} s (step {steps[r]}); the run is not usable (see {work / 'screen.txt'})")
+                           f"{df['t'].iat[r]:.6g} s (step {steps[r]}); the run is not usable "
+                           f"(see {work / 'screen.txt'})")
     return df
 
 
