@@ -7,7 +7,7 @@ for turning and oblique planes (its agreement with pyref on the tilt: test_lammp
 - each contact keeps its own wall's history when a grain's contacts change; stock's
   bookkeeping (this LAMMPS version) gives a grain that touches a third wall of a block the
   histories of other walls, shown here on one sphere;
-- a contact's history travels with its grain between MPI ranks;
+- a contact's history travels with its grain between MPI ranks and through a restart file;
 - every refusal is one ERROR line naming the argument and its allowed values.
 ~6 s together (most of it the example on 2 ranks).
 """
@@ -146,6 +146,42 @@ run 3000
     # columns: id x y z vx vy vz fx fy fz omegax omegay omegaz Fn Fs_x slips
     assert last[1] > 5.15  # carried across the middle (x = 5) and past a rebuild
     assert last[13] > 0 and last[15] == 0 and last[14] == pytest.approx(10.0, rel=0.1)  # held, never slipped
+
+
+def test_a_restart_continues_each_contacts_history(tmp_path):
+    """The belt of the test above, serial: 1000 steps, write_restart, read_restart and 1000
+    more, against 2000 in one run. The spring holds the grain against the 10 units of force
+    with D = 1e-3; a history lost at the restart would let it slip back by ~1e-3. A run split
+    in two is not one run in LAMMPS (the second run's set-up evaluates the forces again with
+    the full-step velocities: lammps_plugin/README.md), which moves the grain by ~1e-7 here
+    (measured 1.4e-7): the two must agree within 1e-5, a hundredth of a lost spring."""
+    rest = 100.0 / KN
+    setup = f"""pair_style gran/hooke/history {KN!r} {KT!r} 10.0 NULL 0.5 1
+pair_coeff * *
+comm_modify vel yes
+variable dx equal 0.1*step*{DT!r}
+region belt plane 0 0 0 0 0 1 side in units box move v_dx NULL NULL
+fix w all {STYLE} hooke/history {KN!r} {KT!r} 10.0 NULL 0.5 1 region belt mu_k 0.45 record yes
+fix grav all gravity 100.0 vector 0 0 -1
+fix hold all addforce -10.0 0.0 0.0
+fix nve all nve
+timestep {DT!r}
+"""
+    start = f"""units lj
+atom_style sphere
+atom_modify map array
+boundary f f f
+region box block 0 10 -1 1 -1 1 units box
+create_box 1 box
+create_atoms 1 single 4.9 0.0 {0.5 - rest!r} units box
+set atom 1 diameter 1.0 mass 1.0
+""" + setup
+    end = "dump d all custom 1000 dump.out id x f_w[13]\ndump_modify d format float %.17g\n"
+    run_lammps(tmp_path / "one", "belt", start + end + "run 2000\n")
+    run_lammps(tmp_path / "two", "first", start + "run 1000\nwrite_restart belt.restart\n")
+    run_lammps(tmp_path / "two", "second", "read_restart belt.restart\n" + setup + end + "run 1000\n")
+    one, two = read_dump(tmp_path / "one" / "dump.out")[2000][0], read_dump(tmp_path / "two" / "dump.out")[2000][0]
+    assert abs(one[1] - two[1]) < 1e-5 and one[2] == two[2] == 0  # the same place, no slip in either
 
 
 @pytest.mark.parametrize("args, words", [
