@@ -206,7 +206,8 @@ class _Script:
                 self.add(f"variable {name[2:]} equal {_fmt(v[a])}*step*{_fmt(sc.dt)}")
             region += " move " + " ".join(moves)
             self.notes.append(f"wall {w.name} moves as a LAMMPS region, which has no velocity in the set-up force "
-                              "evaluation (pyref: the wall's velocity): the first half step differs if it touches a grain")
+                              "evaluation (pyref: the wall's velocity): the first half step differs if it touches "
+                              "a grain")
         self.add(region, f"fix {fid} all wall/gran/region/stickslip hooke/history {args} region r{k} {keywords}")
 
     def _gravity(self):

@@ -367,7 +367,8 @@ def _timeseries(script, work):
         cols.update(zip(columns.STATS, ([int(round(stats[s][0][1])) for s in steps],
                                         [float(stats[s][0][2]) for s in steps])))
     if sc.output.slip_stats:
-        cols.update(zip(columns.SLIP_STATS, slip_stats(script, atoms, _read_dump(work / "slips.dump"), steps, fn_col=3)))
+        slips = _read_dump(work / "slips.dump")  # id1 id2 - Fn F_s(3) count
+        cols.update(zip(columns.SLIP_STATS, slip_stats(script, atoms, slips, steps, fn_col=3)))
     df = pd.DataFrame(cols)
     bad = ~np.isfinite(df.to_numpy(dtype=float))
     if bad.any():
