@@ -3,11 +3,12 @@
 #   ./run.sh report   set up, then run every paper case on every engine -> report/report.md
 #   ./run.sh test     set up, then run the test suite
 # Setup: Debian packages (when root; otherwise it says what to install), a Python
-# virtual environment in .venv with the project installed, and the LIGGGHTS plugin.
+# virtual environment in .venv with the project installed, the LIGGGHTS plugin, and the LAMMPS
+# plugin (with the LAMMPS headers it needs, taken from Debian's source package).
 set -euo pipefail
 cd "$(dirname "$0")"
 
-APT_PACKAGES="python3-venv python3-pip liggghts libliggghts-dev liggghts-doc libopenmpi-dev openmpi-bin g++ cmake yade python3-numpy"
+APT_PACKAGES="python3-venv python3-pip liggghts libliggghts-dev liggghts-doc libopenmpi-dev openmpi-bin g++ cmake yade python3-numpy lammps liblammps-dev lammps-examples"
 
 setup_system() {
     local missing=()
@@ -51,10 +52,55 @@ setup_plugin() {
     fi
 }
 
+setup_lammps_headers() {
+    # liblammps-dev ships only 36 core headers (and not the fmt/ headers they include), none of
+    # GRANULAR's: the plugin takes the matching ones from Debian's own source package of the
+    # installed version (80 MB, downloaded once into build/lammps_source/), extracting only
+    # src/*.h, src/GRANULAR/*.h and src/fmt/* (~7 s). Nothing is built from it.
+    local dir=build/lammps_headers cache=build/lammps_source version
+    [ -f "$dir/.complete" ] && return 0
+    command -v lmp >/dev/null 2>&1 || return 0
+    version="$(dpkg-query -W -f='${source:Version}' liblammps-dev 2>/dev/null)" || return 0
+    mkdir -p "$cache"
+    if ! ls "$cache"/lammps_*.orig.tar.* >/dev/null 2>&1; then
+        if ! apt-get source --print-uris "lammps=$version" >/dev/null 2>&1; then
+            if [ "$(id -u)" -ne 0 ]; then
+                echo "setup: no deb-src entry for lammps $version; as root add one (a copy of" \
+                     "/etc/apt/sources.list.d/debian.sources with 'Types: deb-src'), apt-get update," \
+                     "and run ./run.sh setup again; the LAMMPS plugin is skipped" >&2
+                return 0
+            fi
+            echo "setup: adding a deb-src entry for Debian's sources (LAMMPS headers)"
+            sed 's/^Types: deb$/Types: deb-src/' /etc/apt/sources.list.d/debian.sources \
+                > /etc/apt/sources.list.d/stickslip-deb-src.sources
+            apt-get update -qq
+        fi
+        # (as root apt would hand the download to its _apt user, which cannot write here)
+        (cd "$cache" && apt-get source --download-only -qq -o APT::Sandbox::User=root "lammps=$version" >/dev/null)
+    fi
+    rm -rf "$dir" && mkdir -p "$dir"
+    tar -xJf "$cache"/lammps_*.orig.tar.xz -C "$dir" --strip-components=1 --wildcards \
+        --no-wildcards-match-slash '*/src/*.h' '*/src/GRANULAR/*.h' '*/src/fmt/*'
+    echo "$version" > "$dir/.complete"
+}
+
+setup_lammps_plugin() {
+    # The LAMMPS plugin: styles derived from Debian's GRANULAR classes, built against
+    # /usr/lib's liblammps.so.0 (~25 s the first time on 2 cores; cmake rebuilds only what changed)
+    [ -f lammps_plugin/CMakeLists.txt ] && command -v lmp >/dev/null 2>&1 || return 0
+    setup_lammps_headers
+    [ -f build/lammps_headers/.complete ] || return 0
+    [ -f build/lammps_plugin/CMakeCache.txt ] || \
+        cmake -S lammps_plugin -B build/lammps_plugin -DCMAKE_BUILD_TYPE=Release \
+              -DLAMMPS_HEADERS="$PWD/build/lammps_headers/src" >/dev/null
+    cmake --build build/lammps_plugin -j 2 >/dev/null
+}
+
 setup() {
     setup_system
     setup_python
     setup_plugin
+    setup_lammps_plugin
 }
 
 case "${1:-}" in

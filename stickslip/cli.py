@@ -70,7 +70,7 @@ def build_parser():
                    help="step: slip tested at the end of each step (the paper); exact: each slip at its "
                         "time inside the step (docs/law.md); default: the scene's")
     r.add_argument("--out", type=_folder, help="output folder (default: runs/SCENE/ENGINE)")
-    r.add_argument("--ranks", type=_count, default=1, help="MPI processes (LIGGGHTS only; default 1)")
+    r.add_argument("--ranks", type=_count, default=1, help="MPI processes (LIGGGHTS and LAMMPS; default 1)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
 
     pr = sub.add_parser("precision", help="error vs wall time over a ladder of time steps")
@@ -119,7 +119,7 @@ def build_parser():
     ds.add_argument("--quiet", action="store_true", help="no progress bars")
 
     de = sub.add_parser("drum-engines", help="the drum across engines: costs, how long trajectories agree, "
-                                             "avalanche statistics of LIGGGHTS and YADE (docs/drum.md)")
+                                             "avalanche statistics of each engine (docs/drum.md)")
     de.add_argument("--out", type=_folder, default=Path("docs/drum"), help="tables and figures (default: docs/drum)")
     de.add_argument("--runs", type=_folder, default=Path("runs/drum_study"),
                     help="the runs, kept for resuming (default: runs/drum_study)")

@@ -3,17 +3,19 @@
 Three parts, each written to --out (docs/drum by default) and linked from docs/drum.md:
 - costs: each engine on the drum's first COST_DURATION s (the fill falls and packs into
   ~350 contacts), side by side in one call: grain-steps per second of the engine's own
-  loop, LIGGGHTS on 1 and 2 MPI ranks (costs.csv);
-- divergence: the drum's first DIVERGENCE_DURATION s on pyref, LIGGGHTS (1 and 2 ranks)
-  and YADE, every grain recorded every few steps: how far each engine's grains are from
+  loop, the MPI engines (LIGGGHTS, LAMMPS) on 1 and 2 ranks (costs.csv);
+- divergence: the drum's first DIVERGENCE_DURATION s on pyref and every engine (the MPI
+  engines on 1 and 2 ranks), every grain recorded every few steps: how far each engine's grains are from
   pyref's as time goes on (engines_divergence.csv and .png). The engines solve the same
   equations, so they start equal to round-off; a pile is chaotic, so any difference,
   round-off included, grows by a constant factor per unit time until the trajectories
   have parted (the fitted e-folding time is printed);
-- statistics: LIGGGHTS and YADE each run the drum for --duration s (resumable, kept in
+- statistics: each engine but pyref runs the drum for --duration s (resumable, kept in
   --runs like the study's runs), and their avalanche means are compared with their
   standard errors (engines.csv): after the trajectories part, engines can only agree in
-  distribution.
+  distribution. Rows of engines not run this time stay in engines.csv when they are of
+  the same duration (a YADE run of 40 s takes over half an hour), and every z is against
+  the first engine of the table (ENGINES' order: LIGGGHTS before YADE and LAMMPS).
 """
 from __future__ import annotations
 
@@ -24,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from . import runner
+from .adapters import ENGINES
 from .drum_study import check_duration, load_run, run_one
 from .kinds import drum
 from .scene import find, load, parse
@@ -36,21 +39,27 @@ DIVERGENCE_EVERY = 25  # steps between records
 FIT_RANGE = (1e-13, 1e-5)
 
 
+def _with_two_ranks(engines):
+    """(engine, ranks) of each engine on one rank, then of the MPI engines on two."""
+    return [(e, 1) for e in engines] + [(e, 2) for e in engines if e in runner.MPI_ENGINES]
+
+
 def costs(out, engines, progress=False):
-    """Each engine's cost on the drum's first COST_DURATION s; LIGGGHTS also on 2 ranks."""
+    """Each engine's cost on the drum's first COST_DURATION s; the MPI engines also on 2 ranks."""
     sc = load("drum", duration=COST_DURATION, every=1000)
     rows = []
-    for engine, ranks in [(e, 1) for e in engines] + ([("liggghts", 2)] if "liggghts" in engines else []):
+    for engine, ranks in _with_two_ranks(engines):
         summary, _ = runner.run_scene(sc, engine, Path(out) / "costs" / f"{engine}_{ranks}", progress=progress,
                                       ranks=ranks, write_timeseries=False)
         rows.append({"engine": engine, "ranks": ranks, "steps": summary["steps"], "grains": len(sc.grains),
                      "wall_time_s": summary["wall_time_s"],
                      "grain_steps_per_s": summary["steps"] * len(sc.grains) / summary["wall_time_s"]})
     table = pd.DataFrame(rows)
-    one = table[(table.engine == "liggghts") & (table.ranks == 1)]
-    two = table[(table.engine == "liggghts") & (table.ranks == 2)]
-    if len(one) and len(two):
-        table.loc[two.index, "speedup_vs_1_rank"] = float(one.wall_time_s.iloc[0] / two.wall_time_s.iloc[0])
+    for engine in runner.MPI_ENGINES:
+        one = table[(table.engine == engine) & (table.ranks == 1)]
+        two = table[(table.engine == engine) & (table.ranks == 2)]
+        if len(one) and len(two):
+            table.loc[two.index, "speedup_vs_1_rank"] = float(one.wall_time_s.iloc[0] / two.wall_time_s.iloc[0])
     Path(out).mkdir(parents=True, exist_ok=True)
     table.to_csv(Path(out) / "costs.csv", index=False)
     return table
@@ -64,8 +73,7 @@ def divergence(out, engines, work, progress=False):
     names, _ = drum.mobile(sc)
     cols = [f"{n}_{a}" for n in names for a in "xy"]
     runs = {}
-    for engine, ranks in [("pyref", 1)] + [(e, 1) for e in engines if e != "pyref"] + \
-            ([("liggghts", 2)] if "liggghts" in engines else []):
+    for engine, ranks in [("pyref", 1)] + _with_two_ranks([e for e in engines if e != "pyref"]):
         _, df = runner.run_scene(sc, engine, Path(work) / f"{engine}_{ranks}", progress=progress, ranks=ranks,
                                  write_timeseries=False)
         runs[f"{engine}_{ranks}"] = df
@@ -75,8 +83,10 @@ def divergence(out, engines, work, progress=False):
     xy = {key: df[cols].to_numpy().reshape(len(df), -1, 2) for key, df in runs.items()}
     for key, q in xy.items():
         table[f"{key}_vs_pyref_m"] = np.linalg.norm(q - p, axis=2).max(axis=1)
-    if "liggghts_1" in xy and "liggghts_2" in xy:  # MPI: the same engine, sums in another order
-        table["liggghts_2_vs_liggghts_1_m"] = np.linalg.norm(xy["liggghts_2"] - xy["liggghts_1"], axis=2).max(axis=1)
+    for engine in runner.MPI_ENGINES:  # the same engine, sums in another order
+        if f"{engine}_1" in xy and f"{engine}_2" in xy:
+            table[f"{engine}_2_vs_{engine}_1_m"] = np.linalg.norm(xy[f"{engine}_2"] - xy[f"{engine}_1"],
+                                                                  axis=2).max(axis=1)
     Path(out).mkdir(parents=True, exist_ok=True)
     table.to_csv(Path(out) / "engines_divergence.csv", index=False)
     fits = {c: efolding_time(table["t"].to_numpy(), table[c].to_numpy()) for c in table.columns if c.endswith("_m")}
@@ -98,7 +108,7 @@ def _name(column):
     """'liggghts_2_vs_pyref_m' -> 'liggghts (2 ranks) vs pyref'."""
     def one(key):
         engine, _, ranks = key.partition("_")
-        return f"{engine} ({ranks} rank{'s' if ranks != '1' else ''})" if engine == "liggghts" else engine
+        return f"{engine} ({ranks} rank{'s' if ranks != '1' else ''})" if engine in runner.MPI_ENGINES else engine
     return " vs ".join(one(k) for k in column[:-2].split("_vs_"))
 
 
@@ -139,11 +149,17 @@ def statistics(out, out_runs, engines, duration, progress=True):
                      "avalanches": s["avalanches"], "slides": s["slides"],
                      **{k: s[k] for k in s if k.endswith(("_mean_deg", "_se_deg"))}})
     table = pd.DataFrame(rows)
+    path = Path(out) / "engines.csv"
+    if path.is_file():  # the rows of engines not run now, of the same duration
+        old = pd.read_csv(path)
+        kept = old[~old.engine.isin(engines) & (old.duration_s == duration)]
+        table = pd.concat([kept[[c for c in kept.columns if not c.endswith("_z")]], table], ignore_index=True)
+        table = table.sort_values("engine", key=lambda e: e.map(ENGINES.index), ignore_index=True)
     for key in [k[:-len("_mean_deg")] for k in table.columns if k.endswith("_mean_deg")]:
         m, se = table[f"{key}_mean_deg"], table[f"{key}_se_deg"]
         table[f"{key}_z"] = (m - m.iloc[0]) / np.sqrt(se**2 + se.iloc[0] ** 2)
     Path(out).mkdir(parents=True, exist_ok=True)
-    table.to_csv(Path(out) / "engines.csv", index=False)
+    table.to_csv(path, index=False)
     return table
 
 

@@ -340,7 +340,7 @@ def report_section(report_dir, docs=DOCS):
                              "theta_start_centroid_se_deg", "theta_stop_centroid_mean_deg",
                              "theta_stop_centroid_se_deg", "theta_start_centroid_z", "theta_stop_centroid_z"],
              "costs.csv": None}
-    for name, what in (("engines.csv", "avalanche statistics of the same drum on LIGGGHTS and YADE"),
+    for name, what in (("engines.csv", "avalanche statistics of the same drum on each engine"),
                        ("costs.csv", "each engine's cost on the drum")):
         if (docs / name).is_file():
             table = pd.read_csv(docs / name)

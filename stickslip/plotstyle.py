@@ -1,7 +1,7 @@
 """What every report figure shares: one line style per engine, and saving a figure."""
 from __future__ import annotations
 
-ENGINE_LINES = {"pyref": "-", "liggghts": "--", "yade": ":"}
+ENGINE_LINES = {"pyref": "-", "liggghts": "--", "yade": ":", "lammps": "-."}
 
 
 def pyplot():

@@ -135,9 +135,8 @@ def _paper_table(case, runs):
     sc = next(iter(runs.values()))[0]
     kind = kinds.get(sc.analysis["kind"])
     rows = paper.rows(kind.paper_statements(sc), runs, fmt)
-    engines = ("pyref", "liggghts", "yade")
     columns = sorted({c for *_, values, _, _ in rows for c in values},
-                     key=lambda c: (c[0] != "step", engines.index(c[1]) if c[1] in engines else 9))
+                     key=lambda c: (c[0] != "step", adapters.ENGINES.index(c[1]) if c[1] in adapters.ENGINES else 9))
     timed = len({t for t, _ in columns}) > 1
     head = [f"{e} ({t})" if timed else e for t, e in columns]
     lines = [f"### {case}", "", "| § | the paper says | how we check it | " + " | ".join(head) + " | verdict | why |",

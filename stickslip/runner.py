@@ -26,6 +26,8 @@ from .scene import load as scene_load
 # (rows x columns: ~2 GB of CSV). The absurd is refused by the reader (MAX_* there).
 ANNOUNCE_GRAIN_STEPS = 1e8
 ANNOUNCE_RECORDED = 1e8
+# engines whose adapter runs a scene on several MPI processes (run(..., np_ranks=N))
+MPI_ENGINES = ("liggghts", "lammps")
 
 
 def prepare_output(out_dir) -> Path:
@@ -49,12 +51,13 @@ def prepare_output(out_dir) -> Path:
 
 def run_scene(scene, engine, out_dir, progress=True, ranks=1, write_timeseries=True):
     """Run a validated scene on an engine; write timeseries.csv and summary.json into
-    out_dir; returns (summary, timeseries). ranks > 1: MPI processes (LIGGGHTS only).
+    out_dir; returns (summary, timeseries). ranks > 1: MPI processes (MPI_ENGINES only).
     write_timeseries=False: for a study that keeps only a reduction of the series (a long
     drum run's CSV is gigabytes and takes longer to write than to reduce)."""
     adapter = adapters.get(engine)
-    if ranks > 1 and engine != "liggghts":
-        raise SceneError(f"--ranks {ranks}: only LIGGGHTS runs on several MPI processes (engine {engine}: 1)")
+    if ranks > 1 and engine not in MPI_ENGINES:
+        raise SceneError(f"--ranks {ranks}: only {' and '.join(MPI_ENGINES)} run on several MPI processes "
+                         f"(engine {engine}: 1)")
     reason = adapter.available()
     if reason is not None:
         raise EngineError(f"engine {engine} is not available: {reason}")
@@ -117,9 +120,9 @@ def _one_line(e):
 # engine, only to run the longest jobs first (stickslip/parallel.py). On the paper's
 # small scenes a step costs about the same whatever the grains (pyref: numpy's per-call
 # overhead; YADE: its Python law), so the part per step dominates there.
-_STEP = {"pyref": 5e-5, "liggghts": 2e-6, "yade": 2.5e-4}
-_PER_OBJECT = {"pyref": 1e-6, "liggghts": 3e-7, "yade": 5e-6}
-_START = {"pyref": 0.0, "liggghts": 0.5, "yade": 1.5}
+_STEP = {"pyref": 5e-5, "liggghts": 2e-6, "yade": 2.5e-4, "lammps": 5e-6}
+_PER_OBJECT = {"pyref": 1e-6, "liggghts": 3e-7, "yade": 5e-6, "lammps": 3e-7}
+_START = {"pyref": 0.0, "liggghts": 0.5, "yade": 1.5, "lammps": 0.5}
 
 
 def cost(scene, engine, steps=None) -> float:

@@ -16,7 +16,7 @@ from typing import Callable, Protocol
 
 import pandas as pd
 
-ENGINES = ("pyref", "liggghts", "yade")
+ENGINES = ("pyref", "liggghts", "yade", "lammps")
 
 
 @dataclass

@@ -24,6 +24,8 @@ import pandas as pd
 
 from .. import columns
 from . import RunResult
+from .text_dumps import full_precision as _full_precision, id_ranges as _id_ranges, read_dump as _read_dump
+from .text_dumps import slip_stats
 
 NAME = "liggghts"
 REPO = Path(__file__).resolve().parents[2]
@@ -52,11 +54,6 @@ def _fmt(x):
 
 def _vec(a):
     return " ".join(_fmt(x) for x in a)
-
-
-def _full_precision(dump, ncols, ints=0):
-    """Dumps print 6 digits by default; forces and positions are compared far below that."""
-    return f'dump_modify {dump} format "' + " ".join(["%d"] * ints + ["%.17g"] * (ncols - ints)) + '"'
 
 
 class _Script:
@@ -313,30 +310,6 @@ class _Script:
         return "\n".join(self.lines) + "\n"
 
 
-def _read_dump(path):
-    """Blocks of a LIGGGHTS dump: {step: 2D float array} ('atoms' or 'local' dumps).
-    A block is ITEM: TIMESTEP, the step, ITEM: NUMBER OF ..., the count, ITEM: BOX BOUNDS
-    and three lines of bounds, ITEM: ATOMS|ENTRIES, then the rows. pandas' C parser reads
-    every number of the file at once (the ITEM lines dropped as comments; rows end with a
-    space, hence one more column): a drum run's dumps hold millions of rows, which line by
-    line in Python took a third of the run, and the same values come out (%.17g round-trips)."""
-    with open(path) as f:
-        head = [next(f, "") for _ in range(9)]
-    if not head[0].startswith("ITEM: TIMESTEP"):
-        return {}
-    ncols = len(head[8].split()) - 2  # "ITEM: ATOMS id x y ..." / "ITEM: ENTRIES c_..."
-    v = pd.read_csv(path, sep=" ", header=None, comment="I", names=range(ncols + 1), dtype=float,
-                    engine="c").to_numpy()[:, :ncols]
-    blocks, k = {}, 0
-    while k < len(v):  # the step, the count, three lines of bounds, the rows
-        step, count = int(v[k, 0]), int(v[k + 1, 0])
-        if k + 5 + count > len(v):
-            raise RuntimeError(f"LIGGGHTS: {path} is cut short at step {step} (the run stopped while writing?)")
-        blocks[step] = v[k + 5:k + 5 + count] if count else np.zeros((0, 0))
-        k += 5 + count
-    return blocks
-
-
 def _timeseries(script, work):
     sc = script.scene
     d = sc.dimension
@@ -395,7 +368,8 @@ def _timeseries(script, work):
         cols.update(zip(columns.STATS, ([int(round(stats[s][0][1])) for s in steps],
                                         [float(stats[s][0][2]) for s in steps])))
     if sc.output.slip_stats:
-        cols.update(zip(columns.SLIP_STATS, _slip_stats(script, atoms, _read_dump(work / "slips.dump"), steps)))
+        slips = _read_dump(work / "slips.dump")  # id1 id2 - Fn F_s(3) count
+        cols.update(zip(columns.SLIP_STATS, slip_stats(script, atoms, slips, steps, fn_col=3)))
     df = pd.DataFrame(cols)
     bad = ~np.isfinite(df.to_numpy(dtype=float))
     if bad.any():
@@ -403,78 +377,6 @@ def _timeseries(script, work):
         raise RuntimeError(f"LIGGGHTS produced non-finite values: {df.columns[c]} = {df.iat[r, c]} at t = "
                            f"{df['t'].iat[r]:.6g} s (step {steps[r]}); the run is not usable (see {work / 'screen.txt'})")
     return df
-
-
-def _slip_stats(script, atoms, slips, steps):
-    """columns.SLIP_STATS of every row from the pair records (slips.dump: id1 id2 - Fn F_s(3)
-    count, at each row's step and the step before) and the grains (atoms.dump, every grain):
-    a contact slipped in the row's step when its counter moved from the step before (a new
-    contact: when it is not zero). |V_s| from the dumped velocities and spins, with lever
-    arms to the contact point midway in the overlap (docs/law.md), and the velocities the
-    contact force was computed with: velocity Verlet's half step, v(n+1/2) = v(n+1) -
-    dt/2 f(n+1)/m (and the spins alike), from the dumped end-of-step velocities and
-    forces (fixed grains are not integrated: zero). With the end-of-step velocities a
-    contact sliding at the threshold speed could be counted on the other side of it."""
-    sc, p = script.scene, script.scene.contact.law_params(script.scene.effects)
-    radius, half_dt_m, half_dt_i = (np.zeros(len(sc.grains) + 1) for _ in range(3))
-    for g in sc.grains:
-        k = script.ids[g.name]
-        radius[k] = g.radius
-        if not g.fixed:
-            half_dt_m[k], half_dt_i[k] = 0.5 * sc.dt / sc.grain_mass(g), 0.5 * sc.dt / sc.grain_inertia(g)
-    fc = script.force_col
-    row_of = np.zeros(max(script.recorded) + 1, int)  # atom id -> its row in atoms.dump (sorted by id)
-    row_of[script.recorded] = np.arange(len(script.recorded))
-    big = len(sc.grains) + 1
-
-    def key(a, b):  # a pair by its two ids in either order: a neighbour-list rebuild may swap them
-        return np.minimum(a, b) * big + np.maximum(a, b)
-
-    rows = []
-    for s in steps:
-        blk = slips.get(s, np.zeros((0, 8)))
-        if not len(blk):
-            rows.append((0, 0, 0, 0.0))
-            continue
-        i, j = blk[:, 0].astype(int), blk[:, 1].astype(int)
-        prev = slips.get(s - 1, np.zeros((0, 8)))
-        was = np.zeros(len(blk))  # each pair's counter at the step before (0: not in contact then)
-        if len(prev):
-            before = key(prev[:, 0].astype(int), prev[:, 1].astype(int))
-            order = np.argsort(before)
-            at = np.minimum(np.searchsorted(before[order], key(i, j)), len(order) - 1)
-            found = before[order][at] == key(i, j)
-            was[found] = prev[order[at[found]], 7]
-        count = blk[:, 7]
-        sel = (count != was) & (count > 0) & (blk[:, 3] > 0)
-        a = atoms[s]
-        ids = a[:, 0].astype(int)
-        v = a[:, 4:7] - half_dt_m[ids][:, None] * a[:, fc:fc + 3]  # the half step's, as the force saw them
-        w = a[:, 7:10] - half_dt_i[ids][:, None] * a[:, fc + 3:fc + 6]
-        ri, rj = row_of[i[sel]], row_of[j[sel]]
-        d = a[rj, 1:4] - a[ri, 1:4]
-        dist = np.linalg.norm(d, axis=1)
-        n = d / dist[:, None]
-        half = 0.5 * (radius[i[sel]] + radius[j[sel]] - dist)
-        lever = (radius[i[sel]] - half)[:, None] * w[ri] + (radius[j[sel]] - half)[:, None] * w[rj]
-        v_rel = v[ri] - v[rj] + np.cross(lever, n)
-        vs = np.linalg.norm(v_rel - np.sum(v_rel * n, axis=1)[:, None] * n, axis=1)
-        fn = blk[sel, 3]
-        drop = 2.0 * (p.mu_s - p.mu_k) * fn
-        ratio = np.linalg.norm(blk[sel, 4:7], axis=1) / np.where(fn > 0, fn, np.inf)
-        rows.append((int(sel.sum()), int(np.sum(vs * p.nu_s >= drop)),
-                     int(np.sum(vs * (p.nu_s + p.ks * sc.dt) >= drop)), float(ratio.sum())))
-    return [list(c) for c in zip(*rows)]
-
-
-def _id_ranges(ids):
-    """Atom ids as LIGGGHTS group ranges: 1 2 3 5 -> '1:3 5'."""
-    parts, start = [], ids[0]
-    for prev, cur in zip(ids, ids[1:] + [None]):
-        if cur != prev + 1:
-            parts.append(str(start) if start == prev else f"{start}:{prev}")
-            start = cur
-    return " ".join(parts)
 
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):

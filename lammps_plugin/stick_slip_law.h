@@ -1,0 +1,318 @@
+/* stickslip: the stick-slip tangential contact law of Khellaf & Mansouri (2024) on LAMMPS.
+
+   This file is the only place the law lives on LAMMPS (the pair style and the walls call
+   it); it follows docs/law.md step by step, with the branch order and constants of
+   pyref/laws.py and liggghts_plugin/tangential_model_stick_slip.h. The exact slip timing's
+   engine-independent part (E1-E7) is exact_slip_timing.h.
+
+   With the default settings (reset total, slip_timing step, history_rotation project,
+   damping mass, lever_arm radius) and mu_k = mu_s the arithmetic is stock
+   gran/hooke/history's, operation for operation, so that renaming the styles changes no
+   bit of a run (lammps_plugin/README.md says where the law differs from stock). */
+
+#ifndef STICKSLIP_LAMMPS_LAW_H
+#define STICKSLIP_LAMMPS_LAW_H
+
+#include "exact_slip_timing.h"
+
+#include "error.h"
+#include "lammps.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+namespace StickSlip {
+
+/* Per-contact history: the spring D (3 values, stock's shear), and with `record yes` what
+   the law last applied and what the contact has done since it began. Every value but D and
+   Fs is the same seen from either body of a pair (transfer_history). */
+enum {
+  HIST_D = 0,       // D, the spring elongation (eq. 7), 3 values
+  SIZE_PLAIN = 3,   // without record: stock's 3 values
+  HIST_FN = 3,      // Fn applied, signed (> 0 pushes the bodies apart), force units
+  HIST_FS = 4,      // tangential force applied on this body, 3 values
+  HIST_NSLIP = 7,   // steps in which the contact slipped (the adapters' c_slip)
+  HIST_WORK = 8,    // work the tangential law dissipated (docs/law.md "Energy")
+  SIZE_RECORD = 9
+};
+
+// The law's keywords (lammps_plugin/README.md). Defaults: stock gran/hooke/history.
+struct Settings {
+  double mu_k = -1.0;          // kinetic coefficient; < 0: not given, mu_k = mu_s (stock)
+  bool reset_total = true;     // eq. 8: spring + dashpot hold Fmin (stock's rescale); false: the spring alone
+  bool exact = false;          // slip_timing exact: every slip at its time in the step (E0-E7)
+  bool project = true;         // history_rotation project (stock); false: keep_length (docs/law.md step 3)
+  bool absolute = false;       // damping absolute: gamma_n, gamma_t are nu_n, nu_s; false: meff * gamma
+  bool contact_lever = false;  // lever_arm contact: c = r - delta/2; false: the radius (stock)
+  bool record = false;         // keep Fn, Fs, slip count and work in the contact history
+
+  int history_size() const { return record ? SIZE_RECORD : SIZE_PLAIN; }
+};
+
+/* A number argument, or one error line naming it and its allowed range. */
+inline double parse_number(LAMMPS_NS::LAMMPS *lmp, const std::string &cmd, const std::string &name, const char *text,
+                           const char *allowed)
+{
+  char *end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || errno || !std::isfinite(v))
+    lmp->error->all(FLERR, cmd + ": " + name + " = '" + text + "' is not a number (allowed: " + allowed + ")");
+  return v;
+}
+
+/* One error line when a value is outside its allowed range. */
+inline void check_range(LAMMPS_NS::LAMMPS *lmp, const std::string &cmd, const std::string &name, double v, bool ok,
+                        const char *allowed)
+{
+  if (ok) return;
+  char value[40];
+  snprintf(value, sizeof value, "%g", v);
+  lmp->error->all(FLERR, cmd + ": " + name + " = " + value + " is outside its allowed range: " + allowed);
+}
+
+/* Reads one of the law's keywords at arg[iarg] into s. Returns the number of words used;
+   0 if arg[iarg] is not a law keyword. Errors name the command, the keyword and the
+   allowed values. */
+inline int parse_keyword(LAMMPS_NS::LAMMPS *lmp, const std::string &cmd, Settings &s, int narg, char **arg, int iarg)
+{
+  struct Choice {
+    const char *keyword, *yes, *no;
+    bool Settings::*flag;
+  };
+  static const Choice choices[] = {
+      {"reset", "total", "spring", &Settings::reset_total},
+      {"slip_timing", "exact", "step", &Settings::exact},
+      {"history_rotation", "project", "keep_length", &Settings::project},
+      {"damping", "absolute", "mass", &Settings::absolute},
+      {"lever_arm", "contact", "radius", &Settings::contact_lever},
+      {"record", "yes", "no", &Settings::record},
+  };
+  const std::string key = arg[iarg];
+  if (key == "mu_k") {
+    if (iarg + 1 >= narg) lmp->error->all(FLERR, cmd + ": keyword mu_k needs a value (mu_s/2 <= mu_k <= mu_s)");
+    s.mu_k = parse_number(lmp, cmd, "mu_k", arg[iarg + 1], "mu_s/2 <= mu_k <= mu_s");
+    check_range(lmp, cmd, "mu_k", s.mu_k, s.mu_k >= 0.0, "mu_s/2 <= mu_k <= mu_s");
+    return 2;
+  }
+  for (const Choice &c : choices) {
+    if (key != c.keyword) continue;
+    const std::string allowed = std::string(c.yes) + " or " + c.no;
+    if (iarg + 1 >= narg) lmp->error->all(FLERR, cmd + ": keyword " + key + " needs a value: " + allowed);
+    const std::string value = arg[iarg + 1];
+    if (value == c.yes)
+      s.*c.flag = true;
+    else if (value == c.no)
+      s.*c.flag = false;
+    else
+      lmp->error->all(FLERR, cmd + ": " + key + " '" + value + "' is not allowed: " + allowed);
+    return 2;
+  }
+  return 0;
+}
+
+// the keywords parse_keyword knows, for the message about an unknown one
+inline const char *keyword_list()
+{
+  return "mu_k, reset, slip_timing, history_rotation, damping, lever_arm, record";
+}
+
+/* mu_s/2 <= mu_k <= mu_s (docs/law.md), so that 0 <= Fmin = (2 mu_k - mu_s) Fn <= mu_k Fn. */
+inline void check_kinetic(LAMMPS_NS::LAMMPS *lmp, const std::string &where, double mu_s, double mu_k)
+{
+  if (mu_k >= 0.5 * mu_s && mu_k <= mu_s) return;
+  char msg[200];
+  snprintf(msg, sizeof msg, ": mu_k = %g is outside its allowed range [mu_s/2, mu_s] = [%g, %g] (mu_s = %g)", mu_k,
+           0.5 * mu_s, mu_s, mu_s);
+  lmp->error->all(FLERR, where + msg);
+}
+
+/* The coefficients of one kind of contact (a type pair, or a wall). */
+struct Coeffs {
+  double kt;     // Ks (eq. 5)
+  double mu_s;   // static coefficient: threshold mu_s |Fn| (stock's xmu)
+  double kin;    // 2 mu_k - mu_s: Fmin = kin |Fn|; exactly mu_s when mu_k = mu_s
+  double ratio;  // Fmin/T = (2 mu_k - mu_s)/mu_s, exactly 1 iff mu_k = mu_s (exact timing)
+};
+
+inline Coeffs make_coeffs(double kt, double mu_s, double mu_k)
+{
+  Coeffs c;
+  c.kt = kt;
+  c.mu_s = mu_s;
+  c.kin = 2.0 * mu_k - mu_s;
+  c.ratio = mu_s > 0.0 ? c.kin / mu_s : 1.0;
+  return c;
+}
+
+/* Exact slip timing (docs/law.md E0-E7) for a step in which the trial force reached the
+   threshold at its start or end. F: in, the trial force at the end of the step (spring
+   after its increment, + dashpot); out, the force applied. D: out, the spring at the end.
+   Returns the share of the step spent sticking. (Out of line: it runs only in steps that
+   slip.) */
+__attribute__((noinline)) inline double exact_step(const Settings &s, const Coeffs &c, double fnabs, const double *vtr,
+                                                   double nu_s, double dt, double start2, const double *F0, double *F,
+                                                   double *D)
+{
+  const double kt = c.kt, limit = c.mu_s * fnabs, fmin = c.kin * fnabs;
+  const double vs2 = stickslip::dot3(vtr, vtr);
+  if (start2 >= limit * limit && limit > 0.0 && !s.reset_total && nu_s * nu_s * vs2 > 0.0 &&
+      (fmin * fmin + nu_s * nu_s * vs2 - limit * limit) * std::sqrt(start2) -
+              2.0 * fmin * nu_s * stickslip::dot3(F0, vtr) >=
+          0.0) {
+    // E4 at the step's start, the common slipping case in dense flows: the force is at or
+    // above T at theta = 0 and after the slip the dashpot alone keeps it there,
+    // |Fmin t0 + nu_s |V_s| u| >= T with t0 = F0/|F0|, u = -V_s/|V_s| (expanded: one square
+    // root, no division). The contact slides at Fmin u all step; the spring holds the trial
+    // force (Fmin + nu_s |V_s|) u less the dashpot, i.e. Fmin u (eq. 5).
+    const double a = fmin / std::sqrt(vs2), akt = a / kt;
+    for (int k = 0; k < 3; k++) {
+      F[k] = -a * vtr[k];
+      D[k] = akt * vtr[k];
+    }
+    return 0.0;
+  }
+  // E6 applies when nothing is added at the reset (reset total, or no dashpot)
+  const bool flow_law = c.ratio == 1.0 && (s.reset_total || nu_s == 0.0);
+  double applied[3], trial[3], stick;
+  stickslip::exact_slips(F0, vtr, limit, fmin, c.ratio, kt, nu_s, dt, s.reset_total, flow_law, applied, trial,
+                         stick);
+  // the spring at the end holds the trial force less the dashpot (eq. 5)
+  for (int k = 0; k < 3; k++) {
+    F[k] = applied[k];
+    D[k] = -(trial[k] + nu_s * vtr[k]) / kt;
+  }
+  return stick;
+}
+
+/* The tangential law at one contact for one force evaluation (docs/law.md steps 3-5).
+   del: x_i - x_j (for a wall, the body's offset from the wall), rsqinv = 1/|del|^2;
+   ccel_r = Fn, signed as stock computes it (ccel*r: > 0 pushes apart; it is tensile only
+   where stock's damping makes it so, and the threshold uses |Fn| as stock does);
+   vtr = V_s (eq. 6), the velocity of i's contact point relative to j's; nu_s: the
+   tangential damping (meff * gamma_t, or gamma_t with damping absolute);
+   update: a step (false: a set-up evaluation, no time passes and D is not loaded);
+   hist: the contact's history (layout above). Out: fs, the tangential force on i.
+   (Always inlined: it runs for every contact of every step, and a call would cost the
+   caller's registers; the rare paths it calls are out of line.) */
+__attribute__((always_inline)) inline void tangential_force(const Settings &s, const Coeffs &c, const double *del,
+                                                            double rsqinv, double ccel_r, const double *vtr,
+                                                            double nu_s, double dt, bool update, double *hist,
+                                                            double *fs)
+{
+  const double kt = c.kt;
+  double D[3] = {hist[0], hist[1], hist[2]};
+  bool zero_spring = false;  // stock's rule, history_rotation project: see the slip below
+  if (s.project) {
+    // stock: increment (eq. 7), then project onto the current tangent plane
+    if (update) {
+      D[0] += vtr[0] * dt;
+      D[1] += vtr[1] * dt;
+      D[2] += vtr[2] * dt;
+    }
+    zero_spring = D[0] * D[0] + D[1] * D[1] + D[2] * D[2] == 0.0;
+    double rsht = D[0] * del[0] + D[1] * del[1] + D[2] * del[2];
+    rsht *= rsqinv;
+    if (update) {
+      D[0] -= rsht * del[0];
+      D[1] -= rsht * del[1];
+      D[2] -= rsht * del[2];
+    }
+  } else if (update) {
+    // docs/law.md step 3: turn D into the current tangent plane keeping its length,
+    // D <- (D - dn n) * sqrt(old2/new2), new2 = old2 (1 - x), x = dn^2/old2 (n = del/|del|)
+    const double dd = D[0] * del[0] + D[1] * del[1] + D[2] * del[2];
+    if (dd != 0.0) {
+      const double old2 = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+      const double x = dd * dd * rsqinv / old2;  // sin^2 of the angle between D and the plane
+      const double rsht = dd * rsqinv;
+      for (int k = 0; k < 3; k++) D[k] -= rsht * del[k];
+      // the contact turns by less than 1e-3 rad in a step (nearly always): the series of
+      // (1 - x)^(-1/2), whose first dropped term, 5x^3/16 < 4e-19, is below round-off,
+      // spares the square root on the path every contact takes
+      double scale = 1.0 + x * (0.5 + 0.375 * x);
+      if (!(x < 1e-6)) {
+        const double new2 = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+        scale = new2 > 0.0 ? std::sqrt(old2 / new2) : 1.0;
+      }
+      for (int k = 0; k < 3; k++) D[k] *= scale;
+    }
+    for (int k = 0; k < 3; k++) D[k] += vtr[k] * dt;  // eq. 7
+  }
+
+  // eq. 5: trial force = spring + dashpot
+  fs[0] = -(kt * D[0] + nu_s * vtr[0]);
+  fs[1] = -(kt * D[1] + nu_s * vtr[1]);
+  fs[2] = -(kt * D[2] + nu_s * vtr[2]);
+
+  // slip test (docs/law.md step 5): |F_t| >= mu_s |Fn|, squared so that a sticking step
+  // (the common case) needs no square root
+  const double fnabs = std::fabs(ccel_r);
+  const double limit = c.mu_s * fnabs;
+  const double sum = fs[0] * fs[0] + fs[1] * fs[1] + fs[2] * fs[2];
+  bool slipped = sum >= limit * limit;
+  if (s.exact) {
+    // E0: |F| moves on a line during the step and is convex in time, so the step has no
+    // slip iff it is below the threshold at both ends; then it is exactly the step mode.
+    // An evaluation without update (set-up) is a step of length 0.
+    const double h = update ? dt : 0.0;
+    const double ktdt = kt * h;
+    // the trial force at the step's start: the spring before the increment V_s dt
+    const double F0[3] = {fs[0] + ktdt * vtr[0], fs[1] + ktdt * vtr[1], fs[2] + ktdt * vtr[2]};
+    const double start2 = stickslip::dot3(F0, F0);
+    slipped = slipped || start2 >= limit * limit;
+    if (slipped) exact_step(s, c, fnabs, vtr, nu_s, h, start2, F0, fs, D);
+  } else if (slipped) {
+    if (zero_spring) {
+      // stock's rule: a contact whose spring is zero (a new contact in a set-up pass) gets no
+      // tangential force when the dashpot alone exceeds the threshold; D stays zero
+      fs[0] = fs[1] = fs[2] = 0.0;
+    } else {
+      // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) |Fn| along the trial force
+      const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;
+      if (s.reset_total) {
+        // eq. 8, reset total: spring + dashpot = Fmin (stock's rescale of the shear)
+        for (int k = 0; k < 3; k++) {
+          const double dv = nu_s * vtr[k] / kt;
+          D[k] = ratio * (D[k] + dv) - dv;
+        }
+      }
+      fs[0] *= ratio;
+      fs[1] *= ratio;
+      fs[2] *= ratio;
+      // eq. 8, reset spring (the paper): Ks |D| = Fmin
+      if (!s.reset_total)
+        for (int k = 0; k < 3; k++) D[k] = -fs[k] / kt;
+    }
+  }
+
+  if (s.record) {
+    if (update) {
+      // docs/law.md "Energy": the work the contact received this step, -F_s.V_s dt, less
+      // the increase of the spring energy Ks |D|^2/2
+      const double before = hist[0] * hist[0] + hist[1] * hist[1] + hist[2] * hist[2];
+      const double after = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
+      hist[HIST_WORK] += -stickslip::dot3(fs, vtr) * dt - 0.5 * kt * (after - before);
+      if (slipped) hist[HIST_NSLIP] += 1.0;
+    }
+    hist[HIST_FN] = ccel_r;
+    for (int k = 0; k < 3; k++) hist[HIST_FS + k] = fs[k];
+  }
+  hist[0] = D[0];
+  hist[1] = D[1];
+  hist[2] = D[2];
+}
+
+/* The lever arm from a body's centre to the contact: its radius (stock), or with
+   lever_arm contact the distance to the middle of the overlap, c = r - delta/2 (docs/law.md
+   step 1). */
+inline double lever(const Settings &s, double radius, double overlap)
+{
+  return s.contact_lever ? radius - 0.5 * overlap : radius;
+}
+
+}  // namespace StickSlip
+
+#endif
