@@ -8,6 +8,8 @@
 
 #include "pair_gran_hooke_stickslip.h"
 
+#include "contact_history_fix.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "error.h"
@@ -171,7 +173,12 @@ void PairGranHookeStickSlip::init_style()
   if (history_made && history_made != size_history)
     error->all(FLERR, CMD + ": record cannot change once the style has run (its contact history holds " +
                           std::to_string(history_made) + " values per contact): issue pair_style none first");
-  PairGranHookeHistory::init_style();
+  // stock's set-up, its history fix made as our ContactHistoryFix (same ID and style name:
+  // write_restart keeps every contact's history, contact_history_fix.h)
+  if (fix_history == nullptr)
+    ContactHistoryFix::creating_history_fix(modify, [this] { PairGranHookeHistory::init_style(); });
+  else
+    PairGranHookeHistory::init_style();
   history_made = size_history;
 }
 
