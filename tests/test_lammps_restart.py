@@ -15,7 +15,7 @@ only, whichever rank holds it).
 
 The scene: a flowing pile, 539 grains on a lattice in a box periodic in x and y, on a
 floor wall, under gravity tilted 26 degrees as examples/pour's chute, examples/pour's
-material (Kn 2000, dt 0.001, mu_s 0.5); two ranks split it along x, and the flow carries
+material (Kn 2000, dt 0.001, mu_s 0.5); two ranks split it along x (`processors * 1 1`), and the flow carries
 grains and contacts across the ranks' boundary and the periodic ones.
 """
 import fcntl
@@ -44,6 +44,7 @@ def scene(styles="ours", law=LAW, newton="off"):
     return f"""atom_style sphere
 boundary p p fm
 newton {newton}
+processors * 1 1
 comm_modify vel yes
 region reg block -6 6 -4 4 -0.5 12 units box
 create_box 1 reg
@@ -120,7 +121,7 @@ def writer(law=LAW):
 def reader(every=N2 // 4, law=LAW, newton="off"):
     """Continues the restart file (the pair style and its coefficients come from the file;
     `newton` does not: LAMMPS keeps the current setting, on by default)."""
-    return (f"newton {newton}\nread_restart restart.n1\nneighbor 0.2 bin\nneigh_modify delay 0\n"
+    return (f"newton {newton}\nprocessors * 1 1\nread_restart restart.n1\nneighbor 0.2 bin\nneigh_modify delay 0\n"
             + fixes("ours", law) + output(every) + f"run {N2}\n")
 
 
