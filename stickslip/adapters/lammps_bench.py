@@ -101,6 +101,7 @@ fix zlower all ${{wall}}
 compute c all contact/atom
 compute cs all reduce sum c_c
 thermo_style custom step atoms c_cs
+thermo_modify norm no
 thermo {warm}
 run {warm}
 {before}
@@ -128,6 +129,7 @@ exit 1
 """
 
 LOOP = re.compile(r"Loop time of (\S+) on (\d+) procs for (\d+) steps with (\d+) atoms")
+CPU_USE = re.compile(r"([\d.]+)% CPU use with")
 
 
 def _env(nproc=1):
@@ -250,7 +252,10 @@ def _mpi(data, nproc, work):
     (d / "in.timed").write_text(_script(data, STEPS))
     out, foreign = _run(_command("step", nproc), d, nproc)
     loop = LOOP.findall(out)[-1]
-    return {"loop": float(loop[0]), "contacts": _contacts(out, WARM + STEPS), "foreign": foreign}
+    # LAMMPS' "% CPU use": the ranks' CPU time over their wall time; below 100 % the ranks
+    # waited for a core (other processes) or for each other
+    return {"loop": float(loop[0]), "contacts": _contacts(out, WARM + STEPS), "foreign": foreign,
+            "cpu_use": float(CPU_USE.findall(out)[-1])}
 
 
 def measure(rounds=ROUNDS, reps=3, counts=True):
@@ -279,7 +284,8 @@ def rows(res):
     rounds = res["rounds"]
     quiet = [r for r in rounds if all(x["foreign"] <= NOISY for x in r.values())]
     used = quiet if len(quiet) >= 3 else rounds
-    which = f"{len(used)} {'quiet ' if used is quiet else ''}rounds of {len(rounds)}"
+    which = (f"the {len(used)} quiet rounds of {len(rounds)}" if used is quiet else
+             f"{len(rounds)} rounds, {len(quiet)} of them quiet")
     atoms = rounds[0]["stock"]["atoms"]
     tag = f"in.pour's chute, {atoms} grains, {STEPS} steps, 1 process"
     for c in CONFIGS:
@@ -307,10 +313,13 @@ def rows(res):
     t2 = statistics.median(x["loop"] for x in res["mpi"][2])
     n = len(res["mpi"][1])
     busy = max(x["foreign"] for x in res["mpi"][1] + res["mpi"][2])
-    # (2 processes need both cores: other processes' load slows them far more than 1)
+    use = statistics.median(x["cpu_use"] for x in res["mpi"][2])
+    # (2 processes need both cores: other processes' load slows them far more than 1, and
+    # Open MPI's ranks spin while they wait for each other)
     out.append({"benchmark": "lammps", "case": f"{LABEL['step']}: MPI speed-up, 2 processes (Loop time of {STEPS} "
                                               f"steps, median of {n}: 1 process {t1:.3f} s, 2 processes {t2:.3f} s; "
-                                              f"other processes used up to {busy:.1f} cores meanwhile)",
+                                              f"2 processes' CPU use {use:.0f} %; other processes used up to "
+                                              f"{busy:.1f} cores meanwhile)",
                 "value": t1 / t2})
     k1 = statistics.median(x["contacts"] for x in res["mpi"][1])
     k2 = statistics.median(x["contacts"] for x in res["mpi"][2])
