@@ -8,6 +8,8 @@
 
 #include "pair_gran_hooke_stickslip.h"
 
+#include "contact_history_fix.h"
+
 #include "atom.h"
 #include "comm.h"
 #include "error.h"
@@ -171,7 +173,12 @@ void PairGranHookeStickSlip::init_style()
   if (history_made && history_made != size_history)
     error->all(FLERR, CMD + ": record cannot change once the style has run (its contact history holds " +
                           std::to_string(history_made) + " values per contact): issue pair_style none first");
-  PairGranHookeHistory::init_style();
+  // stock's set-up, its history fix made as our ContactHistoryFix (same ID and style name:
+  // write_restart keeps every contact's history, contact_history_fix.h)
+  if (fix_history == nullptr)
+    ContactHistoryFix::creating_history_fix(modify, [this] { PairGranHookeHistory::init_style(); });
+  else
+    PairGranHookeHistory::init_style();
   history_made = size_history;
 }
 
@@ -191,9 +198,6 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
 {
   ev_init(eflag, vflag);
 
-  // no history update (no time passes) in a set-up evaluation
-  const bool stepping = !update->setupflag;
-
   // rigid bodies: a grain of a rigid body moves with the body's mass (stock)
   if (fix_rigid && neighbor->ago == 0) {
     int unused;
@@ -208,9 +212,44 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
     comm->forward_comm_pair(this);
   }
 
-  double **x = atom->x;
-  const double *radius = atom->radius;
-  const int dnum = size_history;
+  // the contact loop compiled for this combination of the law's settings
+  const int mode = (law.exact ? 4 : 0) + (law.project ? 2 : 0) + (law.record ? 1 : 0);
+  switch (mode) {
+    case 0: contacts<FixedMode<false, false, false>>(); break;
+    case 1: contacts<FixedMode<false, false, true>>(); break;
+    case 2: contacts<FixedMode<false, true, false>>(); break;
+    case 3: contacts<FixedMode<false, true, true>>(); break;
+    case 4: contacts<FixedMode<true, false, false>>(); break;
+    case 5: contacts<FixedMode<true, false, true>>(); break;
+    case 6: contacts<FixedMode<true, true, false>>(); break;
+    default: contacts<FixedMode<true, true, true>>(); break;
+  }
+  if (vflag_fdotr) virial_fdotr_compute();
+}
+
+/* Every grain pair of the neighbour list for one force evaluation (docs/law.md steps 1-6):
+   the normal force and relative velocity as stock computes them (same operations, same
+   order), the tangential force from the law, forces and torques on both grains.
+   Everything a contact reads is copied into locals first: the compiler then keeps it in
+   registers across the loop (members and LAMMPS' arrays could change in any call, such as
+   ev_tally_xyz, and would be loaded again for every contact). */
+template <class Mode> void PairGranHookeStickSlip::contacts()
+{
+  const Settings s = law;
+  const bool stepping = !update->setupflag;  // no history update (no time passes) in a set-up
+  const double kn_ = kn, gamman_ = gamman, gammat_ = gammat, dt_ = dt;
+  const bool limit = limit_damping;
+  const int freeze = freeze_group_bit;
+  const double *rigid = fix_rigid ? mass_rigid : nullptr;
+  Coeffs *const *const pair_coeffs = coeffs;
+
+  double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const int *mask = atom->mask, *type = atom->type;
+  const int nlocal = atom->nlocal;
+  const int newton_pair = force->newton_pair;
+  const bool tally = evflag;
+  constexpr int dnum = Mode::record(Settings()) ? SIZE_RECORD : SIZE_PLAIN;
 
   const int inum = list->inum;
   const int *ilist = list->ilist, *numneigh = list->numneigh;
@@ -226,10 +265,11 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
     double *allhist = firsthist[i];
     const int *jlist = firstneigh[i];
     const int jnum = numneigh[i];
+    const Coeffs *coeffs_i = pair_coeffs[type[i]];
 
     for (int jj = 0; jj < jnum; jj++) {
       const int j = jlist[jj] & NEIGHMASK;
-      double del[3] = {xi - x[j][0], yi - x[j][1], zi - x[j][2]};
+      const double del[3] = {xi - x[j][0], yi - x[j][1], zi - x[j][2]};
       const double rsq = del[0] * del[0] + del[1] * del[1] + del[2] * del[2];
       const double radj = radius[j];
       const double radsum = radi + radj;
@@ -238,94 +278,75 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
       if (rsq >= radsum * radsum) {
         // apart: the contact has ended, its history is dropped (docs/law.md step 3)
         touch[jj] = 0;
-        hist[0] = hist[1] = hist[2] = 0.0;
-        if (dnum > SIZE_PLAIN)
-          for (int m = SIZE_PLAIN; m < dnum; m++) hist[m] = 0.0;
+        for (int m = 0; m < dnum; m++) hist[m] = 0.0;
         continue;
       }
       touch[jj] = 1;
-      contact(i, j, del, rsq, radi, radj, hist, stepping);
+
+      const double r = sqrt(rsq);
+      const double rinv = 1.0 / r;
+      const double rsqinv = 1.0 / rsq;
+
+      // relative translational velocity, its normal and tangential parts
+      const double vr1 = v[i][0] - v[j][0], vr2 = v[i][1] - v[j][1], vr3 = v[i][2] - v[j][2];
+      const double vnnr = vr1 * del[0] + vr2 * del[1] + vr3 * del[2];
+      const double vn1 = del[0] * vnnr * rsqinv, vn2 = del[1] * vnnr * rsqinv, vn3 = del[2] * vnnr * rsqinv;
+      const double vt1 = vr1 - vn1, vt2 = vr2 - vn2, vt3 = vr3 - vn3;
+
+      // rotation: lever arms to the contact (radii, or c = r - delta/2)
+      const double ci = lever(s, radi, radsum - r), cj = lever(s, radj, radsum - r);
+      const double wr1 = (ci * omega[i][0] + cj * omega[j][0]) * rinv;
+      const double wr2 = (ci * omega[i][1] + cj * omega[j][1]) * rinv;
+      const double wr3 = (ci * omega[i][2] + cj * omega[j][2]) * rinv;
+
+      // damping per unit mass times the pair's effective mass (stock), or absolute
+      double meff = 1.0;
+      if (!s.absolute) {
+        double mi = rmass[i], mj = rmass[j];
+        if (rigid) {
+          if (rigid[i] > 0.0) mi = rigid[i];
+          if (rigid[j] > 0.0) mj = rigid[j];
+        }
+        meff = mi * mj / (mi + mj);
+        if (mask[i] & freeze) meff = mj;
+        if (mask[j] & freeze) meff = mi;
+      }
+
+      // normal force (eq. 3): Fn = ccel * r along del
+      const double damp = meff * gamman_ * vnnr * rsqinv;
+      double ccel = kn_ * (radsum - r) * rinv - damp;
+      if (limit && (ccel < 0.0)) ccel = 0.0;
+
+      // V_s (eq. 6): tangential velocity of i's contact point relative to j's
+      const double vtr[3] = {vt1 - (del[2] * wr2 - del[1] * wr3), vt2 - (del[0] * wr3 - del[2] * wr1),
+                             vt3 - (del[1] * wr1 - del[0] * wr2)};
+
+      double fs[3];
+      tangential_force<Mode>(s, coeffs_i[type[j]], del, rsqinv, ccel * r, vtr, meff * gammat_, dt_, stepping, hist,
+                             fs);
+
+      // forces and torques (docs/law.md step 6)
+      const double fx = del[0] * ccel + fs[0], fy = del[1] * ccel + fs[1], fz = del[2] * ccel + fs[2];
+      f[i][0] += fx;
+      f[i][1] += fy;
+      f[i][2] += fz;
+      const double tor1 = rinv * (del[1] * fs[2] - del[2] * fs[1]);
+      const double tor2 = rinv * (del[2] * fs[0] - del[0] * fs[2]);
+      const double tor3 = rinv * (del[0] * fs[1] - del[1] * fs[0]);
+      torque[i][0] -= ci * tor1;
+      torque[i][1] -= ci * tor2;
+      torque[i][2] -= ci * tor3;
+      if (newton_pair || j < nlocal) {
+        f[j][0] -= fx;
+        f[j][1] -= fy;
+        f[j][2] -= fz;
+        torque[j][0] -= cj * tor1;
+        torque[j][1] -= cj * tor2;
+        torque[j][2] -= cj * tor3;
+      }
+      if (tally) ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, fx, fy, fz, del[0], del[1], del[2]);
     }
   }
-  if (vflag_fdotr) virial_fdotr_compute();
-}
-
-/* One touching grain pair (docs/law.md steps 1-6): the normal force and relative velocity
-   as stock computes them, the tangential force from the law, forces and torques on both.
-   del = x_i - x_j, rsq = |del|^2. (Out of line: the loop over neighbours, most of them not
-   touching, keeps its few values in registers.) */
-void PairGranHookeStickSlip::contact(int i, int j, const double *del, double rsq, double radi, double radj,
-                                     double *hist, bool stepping)
-{
-  double **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
-  const double *rmass = atom->rmass;
-  const int *mask = atom->mask, *type = atom->type;
-  const int nlocal = atom->nlocal;
-  const int newton_pair = force->newton_pair;
-  const double radsum = radi + radj;
-  const double r = sqrt(rsq);
-  const double rinv = 1.0 / r;
-  const double rsqinv = 1.0 / rsq;
-
-  // relative translational velocity, its normal and tangential parts
-  const double vr1 = v[i][0] - v[j][0], vr2 = v[i][1] - v[j][1], vr3 = v[i][2] - v[j][2];
-  const double vnnr = vr1 * del[0] + vr2 * del[1] + vr3 * del[2];
-  const double vn1 = del[0] * vnnr * rsqinv, vn2 = del[1] * vnnr * rsqinv, vn3 = del[2] * vnnr * rsqinv;
-  const double vt1 = vr1 - vn1, vt2 = vr2 - vn2, vt3 = vr3 - vn3;
-
-  // rotation: lever arms to the contact (radii, or c = r - delta/2)
-  const double ci = lever(law, radi, radsum - r), cj = lever(law, radj, radsum - r);
-  const double wr1 = (ci * omega[i][0] + cj * omega[j][0]) * rinv;
-  const double wr2 = (ci * omega[i][1] + cj * omega[j][1]) * rinv;
-  const double wr3 = (ci * omega[i][2] + cj * omega[j][2]) * rinv;
-
-  // damping per unit mass times the pair's effective mass (stock), or absolute
-  double meff = 1.0;
-  if (!law.absolute) {
-    double mi = rmass[i], mj = rmass[j];
-    if (fix_rigid) {
-      if (mass_rigid[i] > 0.0) mi = mass_rigid[i];
-      if (mass_rigid[j] > 0.0) mj = mass_rigid[j];
-    }
-    meff = mi * mj / (mi + mj);
-    if (mask[i] & freeze_group_bit) meff = mj;
-    if (mask[j] & freeze_group_bit) meff = mi;
-  }
-
-  // normal force (eq. 3): Fn = ccel * r along del
-  const double damp = meff * gamman * vnnr * rsqinv;
-  double ccel = kn * (radsum - r) * rinv - damp;
-  if (limit_damping && (ccel < 0.0)) ccel = 0.0;
-
-  // V_s (eq. 6): tangential velocity of i's contact point relative to j's
-  const double vtr[3] = {vt1 - (del[2] * wr2 - del[1] * wr3), vt2 - (del[0] * wr3 - del[2] * wr1),
-                         vt3 - (del[1] * wr1 - del[0] * wr2)};
-
-  double fs[3];
-  // (the type pair's coefficients looked up here, in the touching contacts only)
-  tangential_force(law, coeffs[type[i]][type[j]], del, rsqinv, ccel * r, vtr, meff * gammat, dt, stepping, hist,
-                   fs);
-
-  // forces and torques (docs/law.md step 6)
-  const double fx = del[0] * ccel + fs[0], fy = del[1] * ccel + fs[1], fz = del[2] * ccel + fs[2];
-  f[i][0] += fx;
-  f[i][1] += fy;
-  f[i][2] += fz;
-  const double tor1 = rinv * (del[1] * fs[2] - del[2] * fs[1]);
-  const double tor2 = rinv * (del[2] * fs[0] - del[0] * fs[2]);
-  const double tor3 = rinv * (del[0] * fs[1] - del[1] * fs[0]);
-  torque[i][0] -= ci * tor1;
-  torque[i][1] -= ci * tor2;
-  torque[i][2] -= ci * tor3;
-  if (newton_pair || j < nlocal) {
-    f[j][0] -= fx;
-    f[j][1] -= fy;
-    f[j][2] -= fz;
-    torque[j][0] -= cj * tor1;
-    torque[j][1] -= cj * tor2;
-    torque[j][2] -= cj * tor3;
-  }
-  if (evflag) ev_tally_xyz(i, j, nlocal, newton_pair, 0.0, 0.0, fx, fy, fz, del[0], del[1], del[2]);
 }
 
 /* ----------------------------------------------------------------------

@@ -36,8 +36,7 @@ class PairGranHookeStickSlip : public LAMMPS_NS::PairGranHookeHistory {
   double **mu_s_given, **mu_k_given;
   Coeffs **coeffs;
 
-  __attribute__((noinline)) void contact(int i, int j, const double *del, double rsq, double radi, double radj,
-                                         double *hist, bool stepping);
+  template <class Mode> void contacts();
   void allocate_law();
   void pair_coefficients(int i, int j, double &mu_s, double &mu_k) const;
   double *find_history(int i, int j, double &sign) const;

@@ -150,11 +150,12 @@ inline Coeffs make_coeffs(double kt, double mu_s, double mu_k)
 /* Exact slip timing (docs/law.md E0-E7) for a step in which the trial force reached the
    threshold at its start or end. F: in, the trial force at the end of the step (spring
    after its increment, + dashpot); out, the force applied. D: out, the spring at the end.
-   Returns the share of the step spent sticking. (Out of line: it runs only in steps that
-   slip.) */
-__attribute__((noinline)) inline double exact_step(const Settings &s, const Coeffs &c, double fnabs, const double *vtr,
-                                                   double nu_s, double dt, double start2, const double *F0, double *F,
-                                                   double *D)
+   Returns the share of the step spent sticking. (Inlined: in a flowing pile a third of the
+   contact-steps slide (in.pour's chute), nearly all through E4 at the start, whose few
+   operations cost less than a call; the general case, exact_slips, is out of line.) */
+__attribute__((always_inline)) inline double exact_step(const Settings &s, const Coeffs &c, double fnabs,
+                                                        const double *vtr, double nu_s, double dt, double start2,
+                                                        const double *F0, double *F, double *D)
 {
   const double kt = c.kt, limit = c.mu_s * fnabs, fmin = c.kin * fnabs;
   const double vs2 = stickslip::dot3(vtr, vtr);
@@ -187,6 +188,22 @@ __attribute__((noinline)) inline double exact_step(const Settings &s, const Coef
   return stick;
 }
 
+/* Which of the law's branches the tangential force tests at run time. RuntimeMode reads the
+   settings (the walls); FixedMode<EXACT, PROJECT, RECORD> fixes the three that shape the
+   contact's code (the pair style compiles its contact loop once per combination, so that a
+   contact-step carries no test of them). */
+struct RuntimeMode {
+  static bool exact(const Settings &s) { return s.exact; }
+  static bool project(const Settings &s) { return s.project; }
+  static bool record(const Settings &s) { return s.record; }
+};
+
+template <bool EXACT, bool PROJECT, bool RECORD> struct FixedMode {
+  static constexpr bool exact(const Settings &) { return EXACT; }
+  static constexpr bool project(const Settings &) { return PROJECT; }
+  static constexpr bool record(const Settings &) { return RECORD; }
+};
+
 /* The tangential law at one contact for one force evaluation (docs/law.md steps 3-5).
    del: x_i - x_j (for a wall, the body's offset from the wall), rsqinv = 1/|del|^2;
    ccel_r = Fn, signed as stock computes it (ccel*r: > 0 pushes apart; it is tensile only
@@ -197,6 +214,7 @@ __attribute__((noinline)) inline double exact_step(const Settings &s, const Coef
    hist: the contact's history (layout above). Out: fs, the tangential force on i.
    (Always inlined: it runs for every contact of every step, and a call would cost the
    caller's registers; the rare paths it calls are out of line.) */
+template <class Mode = RuntimeMode>
 __attribute__((always_inline)) inline void tangential_force(const Settings &s, const Coeffs &c, const double *del,
                                                             double rsqinv, double ccel_r, const double *vtr,
                                                             double nu_s, double dt, bool update, double *hist,
@@ -204,15 +222,15 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
 {
   const double kt = c.kt;
   double D[3] = {hist[0], hist[1], hist[2]};
-  bool zero_spring = false;  // stock's rule, history_rotation project: see the slip below
-  if (s.project) {
+  double incremented[3];  // history_rotation project: D after the increment (stock's rule at a slip, below)
+  if (Mode::project(s)) {
     // stock: increment (eq. 7), then project onto the current tangent plane
     if (update) {
       D[0] += vtr[0] * dt;
       D[1] += vtr[1] * dt;
       D[2] += vtr[2] * dt;
     }
-    zero_spring = D[0] * D[0] + D[1] * D[1] + D[2] * D[2] == 0.0;
+    for (int k = 0; k < 3; k++) incremented[k] = D[k];
     double rsht = D[0] * del[0] + D[1] * del[1] + D[2] * del[2];
     rsht *= rsqinv;
     if (update) {
@@ -253,7 +271,7 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
   const double limit = c.mu_s * fnabs;
   const double sum = fs[0] * fs[0] + fs[1] * fs[1] + fs[2] * fs[2];
   bool slipped = sum >= limit * limit;
-  if (s.exact) {
+  if (Mode::exact(s)) {
     // E0: |F| moves on a line during the step and is convex in time, so the step has no
     // slip iff it is below the threshold at both ends; then it is exactly the step mode.
     // An evaluation without update (set-up) is a step of length 0.
@@ -265,7 +283,10 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
     slipped = slipped || start2 >= limit * limit;
     if (slipped) exact_step(s, c, fnabs, vtr, nu_s, h, start2, F0, fs, D);
   } else if (slipped) {
-    if (zero_spring) {
+    // (stock's |D| after the increment, tested only here, at a slip)
+    if (Mode::project(s) && incremented[0] * incremented[0] + incremented[1] * incremented[1] +
+                                    incremented[2] * incremented[2] ==
+                                0.0) {
       // stock's rule: a contact whose spring is zero (a new contact in a set-up pass) gets no
       // tangential force when the dashpot alone exceeds the threshold; D stays zero
       fs[0] = fs[1] = fs[2] = 0.0;
@@ -288,7 +309,7 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
     }
   }
 
-  if (s.record) {
+  if (Mode::record(s)) {
     if (update) {
       // docs/law.md "Energy": the work the contact received this step, -F_s.V_s dt, less
       // the increase of the spring energy Ks |D|^2/2

@@ -47,7 +47,11 @@ def run_lammps(workdir, name, script, exe=None, np_=1, env=None, timeout=600, ch
     (workdir / f"in.{name}").write_text(script)
     cmd = [str(exe or LAUNCHER), "-in", f"in.{name}", "-log", f"log.{name}", "-echo", "none", "-nocite"]
     full_env = dict(os.environ, OMP_NUM_THREADS="1", **(env or {}))
-    if np_ > 1:
+    if np_ == 1:
+        # Open MPI's singleton start-up without its daemon: ~0.4 s less per run (measured;
+        # nothing here spawns processes)
+        full_env["OMPI_MCA_ess_singleton_isolated"] = "1"
+    else:
         cmd = ["mpirun", "-np", str(np_), "--oversubscribe"] + cmd
         full_env.update(MPI_ENV)
     t0 = time.perf_counter()

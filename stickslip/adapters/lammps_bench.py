@@ -1,0 +1,352 @@
+"""LAMMPS rows for `stickslip bench`: what `pair_style gran/hooke/stickslip` costs against
+stock `gran/hooke/history`, and how it scales on 2 processes.
+
+The scene is Debian's examples/pour/in.pour: its first run (3000 grains poured onto a floor
+wall, 25 000 steps) is made once with the stock styles and kept as a data file under
+build/lammps_bench/; every timed run reads it and runs in.pour's second part, the chute
+(gravity tilted 26 degrees: the pile flows, about a third of the contact-steps slide). Both
+the pair style and the floor wall are swapped: stock gran/hooke/history + wall/gran, or
+gran/hooke/stickslip + wall/gran/stickslip. in.pour's material (Kn 2000, Kt 2/7 Kn,
+gamma_n 50, xmu = mu_s 0.5) with dampflag 1 (a tangential dashpot, gamma_t = gamma_n/2, in
+every configuration: without it the law's two resets are the same), and the law's own
+settings: mu_k = 0.45 < mu_s (the kinetic drop that makes it a stick-slip law; the LIGGGHTS
+benchmark's 0.45/0.5) and reset spring (docs/law.md's default, the paper's eq. 8), in both
+slip timings; the other rules (history rotation, lever arm, mass damping) are stock's, the
+engine's geometry shared by both styles.
+
+1. Overhead, timed: in each round the three configurations (stock, step, exact) run one
+   after the other as separate processes, the order turning from round to round; each run
+   reads the data, runs WARM untimed steps (the contacts' history builds up again after
+   read_data), then STEPS timed steps. The time is the on-CPU time of the LAMMPS process
+   over the timed steps alone, read from /proc/PID/schedstat by a probe that the input
+   script runs (`shell`) before and after them. Each round's ratio divides two runs made
+   seconds apart; the figure is the geometric mean over the rounds with a 95 % interval
+   (stickslip/ratio_interval.py). The CPU the rest of the machine used during each run is
+   recorded; rounds in which it exceeded NOISY cores are reported apart, and the ratio uses
+   the quiet rounds when there are at least 3 (a busy second core slows a run through the
+   shared caches even when the run keeps its core).
+2. Overhead, counted: callgrind's instructions over CALLGRIND_STEPS steps after the same
+   warm-up (not instrumented), in the whole time step (LAMMPS' Verlet::run) and in the pair
+   style's own functions; the same binaries and input give the same counts whatever the
+   machine's load.
+3. MPI: the step configuration on 1 and on 2 processes (`mpirun -np 2`), LAMMPS' "Loop
+   time" of the timed steps, medians of `reps` runs each alternating 1, 2, 2, 1, ...;
+   speed-up = T1 / T2.
+
+Cost on the 2-core machine, idle: ~15 s once for the pour; ~4 s a round (10 by default);
+~1 min of callgrind (two at a time); ~5 s per MPI repetition.
+
+    python -m stickslip.adapters.lammps_bench [--rounds 10] [--reps 3] [--no-callgrind]
+"""
+from __future__ import annotations
+
+import argparse
+import concurrent.futures
+import hashlib
+import math
+import os
+import re
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from .. import callgrind
+from ..ratio_interval import ratio_interval
+
+ROOT = Path(__file__).resolve().parents[2]
+LAUNCHER = ROOT / "build" / "lammps_plugin" / "lmp-stickslip"
+EXAMPLE = Path("/usr/share/lammps/examples/pour/in.pour")
+CACHE = ROOT / "build" / "lammps_bench"
+
+WARM = 200  # untimed steps after read_data (the history builds up again)
+STEPS = 1000  # timed steps (~0.7 s on one idle core)
+ROUNDS = 10
+NOISY = 0.3  # cores used by other processes during a run above which its round is not quiet
+CALLGRIND_STEPS = 200
+TARGET = {"step": 1.02, "exact": 1.05}  # issue 30: at most this many times stock's cost
+
+STOCK_ARGS = "2000.0 NULL 50.0 NULL 0.5 1"
+LAW = "mu_k 0.45 reset spring"
+WALL = "zplane 0.0 2000.0"  # in.pour's floor
+CONFIGS = {  # the pair style, and the floor wall's fix arguments
+    "stock": (f"gran/hooke/history {STOCK_ARGS}", f"wall/gran hooke/history {STOCK_ARGS} {WALL}"),
+    "step": (f"gran/hooke/stickslip {STOCK_ARGS} {LAW}",
+             f"wall/gran/stickslip hooke/history {STOCK_ARGS} {WALL} {LAW}"),
+    "exact": (f"gran/hooke/stickslip {STOCK_ARGS} {LAW} slip_timing exact",
+              f"wall/gran/stickslip hooke/history {STOCK_ARGS} {WALL} {LAW} slip_timing exact"),
+}
+LABEL = {"stock": "stock gran/hooke/history", "step": "gran/hooke/stickslip, step timing",
+         "exact": "gran/hooke/stickslip, slip_timing exact"}
+PAIR_FUNCTIONS = ("PairGranHookeHistory::compute", "PairGranHookeStickSlip::", "exact_s")
+
+# in.pour's settings around its chute run; ${pair} and ${wall} choose the styles
+TIMED = """\
+atom_style sphere
+boundary p p fm
+newton off
+comm_modify vel yes
+read_data {data}
+neighbor 0.2 bin
+neigh_modify delay 0
+pair_style ${{pair}}
+pair_coeff * *
+timestep 0.001
+fix 1 all nve/sphere
+fix 2 all gravity 1.0 chute 26.0
+fix zlower all ${{wall}}
+compute c all contact/atom
+compute cs all reduce sum c_c
+thermo_style custom step atoms c_cs
+thermo_modify norm no
+thermo {warm}
+run {warm}
+{before}
+thermo {steps}
+run {steps} pre no post no
+{after}"""
+
+# Appends the on-CPU time (ns) of the LAMMPS process that runs it through `shell` (its
+# nearest ancestor named lmp-stickslip) to probe.log. Shell built-ins only.
+PROBE = """\
+#!/bin/sh
+p=$PPID
+while [ "$p" -gt 1 ]; do
+  read -r line < /proc/$p/stat
+  case "$line" in
+    *"(lmp-stickslip)"*)
+      read -r s < /proc/$p/schedstat
+      echo "${s%% *}" >> probe.log
+      exit 0;;
+  esac
+  set -- ${line##*) }
+  p=$2
+done
+exit 1
+"""
+
+LOOP = re.compile(r"Loop time of (\S+) on (\d+) procs for (\d+) steps with (\d+) atoms")
+CPU_USE = re.compile(r"([\d.]+)% CPU use with")
+
+
+def _env(nproc=1):
+    env = dict(os.environ, OMP_NUM_THREADS="1")
+    env.pop("LD_PRELOAD", None)
+    if nproc == 1:
+        env["OMPI_MCA_ess_singleton_isolated"] = "1"  # no Open MPI daemon for a serial run
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    return env
+
+
+def _check():
+    if not LAUNCHER.is_file():
+        raise RuntimeError(f"LAMMPS plugin not built: {LAUNCHER} missing (./run.sh setup)")
+    if not EXAMPLE.is_file():
+        raise RuntimeError(f"{EXAMPLE} missing (apt-get install lammps-examples)")
+
+
+def _busy_seconds():
+    """CPU time all cores have spent busy so far (Linux), in seconds."""
+    with open("/proc/stat") as f:
+        v = [int(x) for x in f.readline().split()[1:]]
+    return (sum(v) - v[3] - (v[4] if len(v) > 4 else 0)) / os.sysconf("SC_CLK_TCK")
+
+
+def _children_cpu():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def _run(cmd, cwd, nproc=1, timeout=3600):
+    """Run a command; returns (stdout, the CPU the rest of the machine used meanwhile, in
+    cores: all cores' busy time less the command's own, over its wall time)."""
+    b0, c0, t0 = _busy_seconds(), _children_cpu(), time.monotonic()
+    p = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
+                       env=_env(nproc), timeout=timeout)
+    wall = time.monotonic() - t0
+    own = _children_cpu() - c0  # (mpirun's ranks are its children: counted too)
+    foreign = max(0.0, (_busy_seconds() - b0 - own) / wall) if wall > 0 else math.inf
+    if p.returncode != 0 or "ERROR" in p.stdout:
+        lines = p.stdout.strip().splitlines() or ["no output"]
+        why = next((x.strip() for x in lines if "ERROR" in x), lines[-1].strip())
+        raise RuntimeError(f"{' '.join(map(str, cmd[:4]))} ... failed (exit {p.returncode}) in {cwd}: {why}")
+    return p.stdout, foreign
+
+
+def _pour():
+    """in.pour's first run (3000 grains poured, stock styles) as a data file; made once."""
+    script = EXAMPLE.read_text()
+    runs = list(re.finditer(r"^run\s+25000\s*$", script, flags=re.M))
+    if len(runs) != 2:
+        raise RuntimeError(f"{EXAMPLE} changed: expected two `run 25000` lines")
+    script = script[:runs[0].end()] + "\nwrite_data pour.data\n"
+    key = hashlib.sha1(script.encode()).hexdigest()[:12]
+    data = CACHE / f"pour-{key}.data"
+    if data.is_file():
+        return data
+    CACHE.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=CACHE) as tmp:
+        (Path(tmp) / "in.pour").write_text(script)
+        _run([str(LAUNCHER), "-in", "in.pour", "-log", "none", "-echo", "none", "-nocite"], tmp)
+        os.replace(Path(tmp) / "pour.data", data)
+    return data
+
+
+def _command(config, nproc=1):
+    pair, wall = CONFIGS[config]
+    cmd = [str(LAUNCHER), "-in", "in.timed", "-log", "none", "-echo", "none", "-nocite", "-var", "pair", pair,
+           "-var", "wall", wall]
+    return (["mpirun", "-np", str(nproc)] + cmd) if nproc > 1 else cmd
+
+
+def _script(data, steps, before="", after=""):
+    return TIMED.format(data=data, warm=WARM, steps=steps, before=before, after=after)
+
+
+def _folder(work, name):
+    d = Path(work) / name
+    d.mkdir(parents=True, exist_ok=True)
+    return d
+
+
+def _timed(data, config, work):
+    """One overhead run: on-CPU seconds of the timed steps, pair contacts at their end, and
+    the other processes' CPU during the run (cores)."""
+    d = _folder(work, f"timed-{config}")
+    (d / "probe.sh").write_text(PROBE)
+    (d / "probe.sh").chmod(0o755)
+    (d / "probe.log").unlink(missing_ok=True)
+    (d / "in.timed").write_text(_script(data, STEPS, "shell ./probe.sh", "shell ./probe.sh"))
+    out, foreign = _run(_command(config), d)
+    marks = [int(x) for x in (d / "probe.log").read_text().split()]
+    if len(marks) != 2:
+        raise RuntimeError(f"{len(marks)} probe marks in {d} (expected 2)")
+    return {"cpu": (marks[1] - marks[0]) * 1e-9, "contacts": _contacts(out, WARM + STEPS), "foreign": foreign,
+            "atoms": int(LOOP.findall(out)[-1][3])}
+
+
+def _contacts(out, step):
+    """Pair contacts at `step` (thermo: step atoms c_cs; contact/atom counts each pair twice)."""
+    rows = [ln.split() for ln in out.splitlines() if re.match(rf"\s*{step}\s+\d+\s+\S+\s*$", ln)]
+    if not rows:
+        raise RuntimeError(f"no thermo line for step {step}")
+    return float(rows[-1][2]) / 2
+
+
+def _counted(data, config, work):
+    """callgrind: instructions in the whole time step and in the pair style, CALLGRIND_STEPS steps."""
+    d = _folder(work, f"callgrind-{config}")
+    (d / "in.timed").write_text(_script(data, CALLGRIND_STEPS, "shell ./callgrind_on.sh"))
+    profiles = callgrind.count(_command(config), d, env=_env(), on_request=True)
+    profile = profiles[-1]
+    pair = sum(v for fn, v in callgrind.self_costs(profile).items() if any(p in fn for p in PAIR_FUNCTIONS))
+    return {"total": callgrind.total(profile), "pair": pair}
+
+
+def _mpi(data, nproc, work):
+    d = _folder(work, f"mpi-{nproc}")
+    (d / "in.timed").write_text(_script(data, STEPS))
+    out, foreign = _run(_command("step", nproc), d, nproc)
+    loop = LOOP.findall(out)[-1]
+    # LAMMPS' "% CPU use": the ranks' CPU time over their wall time; below 100 % the ranks
+    # waited for a core (other processes) or for each other
+    return {"loop": float(loop[0]), "contacts": _contacts(out, WARM + STEPS), "foreign": foreign,
+            "cpu_use": float(CPU_USE.findall(out)[-1])}
+
+
+def measure(rounds=ROUNDS, reps=3, counts=True):
+    """Every figure of the benchmark (a dict; rows() turns it into bench rows)."""
+    _check()
+    data = _pour()
+    order = list(CONFIGS)
+    res = {"rounds": [], "counts": {}, "mpi": {1: [], 2: []}}
+    with tempfile.TemporaryDirectory(prefix="lammps_bench-") as work:
+        for r in range(rounds):
+            turn = order[r % 3:] + order[:r % 3]
+            res["rounds"].append({c: _timed(data, c, work) for c in turn})
+        if counts and callgrind.available():
+            with concurrent.futures.ThreadPoolExecutor(2) as pool:
+                jobs = {c: pool.submit(_counted, data, c, work) for c in order}
+                res["counts"] = {c: j.result() for c, j in jobs.items()}
+        for k in range(reps):
+            for nproc in ((1, 2) if k % 2 == 0 else (2, 1)):
+                res["mpi"][nproc].append(_mpi(data, nproc, work))
+    return res
+
+
+def rows(res):
+    """Rows for bench.csv/bench.md."""
+    out = []
+    rounds = res["rounds"]
+    quiet = [r for r in rounds if all(x["foreign"] <= NOISY for x in r.values())]
+    used = quiet if len(quiet) >= 3 else rounds
+    which = (f"the {len(used)} quiet rounds of {len(rounds)}" if used is quiet else
+             f"{len(rounds)} rounds, {len(quiet)} of them quiet")
+    atoms = rounds[0]["stock"]["atoms"]
+    tag = f"in.pour's chute, {atoms} grains, {STEPS} steps, 1 process"
+    for c in CONFIGS:
+        t = statistics.median(r[c]["cpu"] for r in used) / STEPS
+        k = statistics.median(r[c]["contacts"] for r in used)
+        out.append({"benchmark": "lammps", "case": f"{LABEL[c]}: on-CPU s per step ({tag}; median of {which})",
+                    "contacts": round(k), "seconds_per_step": t, "contact_steps_per_s": k / t, "value": t})
+    for c in ("step", "exact"):
+        ratio, lo, hi = ratio_interval([(r["stock"]["cpu"], r[c]["cpu"]) for r in used])
+        out.append({"benchmark": "lammps", "case": f"{LABEL[c]} / stock, time (geometric mean of {which}, "
+                                                  f"95 % interval {lo:.3f}-{hi:.3f}; target <= {TARGET[c]})",
+                    "value": ratio})
+    counts = res["counts"]
+    if counts:
+        for c in CONFIGS:
+            out.append({"benchmark": "lammps", "case": f"{LABEL[c]}: instructions per step, whole step / pair style "
+                                                      f"(callgrind, {CALLGRIND_STEPS} steps)",
+                        "value": f"{counts[c]['total'] / CALLGRIND_STEPS:.4g} / {counts[c]['pair'] / CALLGRIND_STEPS:.4g}"})
+        for c in ("step", "exact"):
+            out.append({"benchmark": "lammps", "case": f"{LABEL[c]} / stock, instructions: whole step / pair style "
+                                                      f"(target <= {TARGET[c]})",
+                        "value": f"{counts[c]['total'] / counts['stock']['total']:.4f} / "
+                                 f"{counts[c]['pair'] / counts['stock']['pair']:.4f}"})
+    t1 = statistics.median(x["loop"] for x in res["mpi"][1])
+    t2 = statistics.median(x["loop"] for x in res["mpi"][2])
+    n = len(res["mpi"][1])
+    busy = max(x["foreign"] for x in res["mpi"][1] + res["mpi"][2])
+    use = statistics.median(x["cpu_use"] for x in res["mpi"][2])
+    # (2 processes need both cores: other processes' load slows them far more than 1, and
+    # Open MPI's ranks spin while they wait for each other)
+    out.append({"benchmark": "lammps", "case": f"{LABEL['step']}: MPI speed-up, 2 processes (Loop time of {STEPS} "
+                                              f"steps, median of {n}: 1 process {t1:.3f} s, 2 processes {t2:.3f} s; "
+                                              f"2 processes' CPU use {use:.0f} %; other processes used up to "
+                                              f"{busy:.1f} cores meanwhile)",
+                "value": t1 / t2})
+    k1 = statistics.median(x["contacts"] for x in res["mpi"][1])
+    k2 = statistics.median(x["contacts"] for x in res["mpi"][2])
+    out.append({"benchmark": "lammps", "case": "pair contacts at the end, 1 / 2 processes", "value": f"{k1:.0f} / {k2:.0f}"})
+    return out
+
+
+def benchmark(reps=3):
+    """Rows for `stickslip bench` (see the module docstring)."""
+    return rows(measure(ROUNDS, reps))
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--rounds", type=int, default=ROUNDS)
+    ap.add_argument("--reps", type=int, default=3)
+    ap.add_argument("--no-callgrind", action="store_true")
+    a = ap.parse_args(argv)
+    try:
+        res = measure(a.rounds, a.reps, counts=not a.no_callgrind)
+    except RuntimeError as e:
+        print(f"lammps_bench: {e}", file=sys.stderr)
+        return 1
+    for r in rows(res):
+        print(f"{r['case']}: {r['value'] if isinstance(r['value'], str) else format(r['value'], '.4g')}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
