@@ -2,8 +2,8 @@
 
 The plugin's build (`./run.sh setup`): build/lammps_plugin/ holds the launcher
 lmp-stickslip (lmp's command line), libstickslip_lammps.so (LD_PRELOAD) and stickslip.lmp
-(the one-line `include` for the stock lmp). Test modules call `require()` at import: it
-skips them with a one-line reason when LAMMPS or the plugin is missing.
+(the one-line `include` for the stock lmp). Test modules mark themselves
+`needs_engine("lammps")` (conftest): a skip off root, a failure as root.
 """
 import os
 import re
@@ -26,16 +26,6 @@ EXAMPLES = Path("/usr/share/lammps/examples")
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
 CRASH_MARKERS = ("Segmentation fault", "segmentation fault", "core dumped", "Traceback",
                  "Signal:", "signal 11", "Aborted", "terminate called")
-
-
-def require():
-    """Skip the calling test module when LAMMPS or the plugin is missing."""
-    if STOCK is None:
-        pytest.skip("LAMMPS is not installed (`lmp` not on PATH): apt-get install lammps liblammps-dev "
-                    "lammps-examples", allow_module_level=True)
-    if not LAUNCHER.is_file():
-        pytest.skip(f"LAMMPS plugin not built ({LAUNCHER} missing): ./run.sh setup",
-                    allow_module_level=True)
 
 
 def run_lammps(workdir, name, script, exe=None, np_=1, env=None, timeout=600, check=True):

@@ -26,9 +26,10 @@ import shutil
 
 import pytest
 
-from lammps_runs import EXAMPLES, STOCK, read_dump, rename_to_stickslip, require, run_lammps
+from conftest import needs_engine
+from lammps_runs import EXAMPLES, STOCK, read_dump, rename_to_stickslip, run_lammps
 
-require()
+pytestmark = needs_engine("lammps")  # LAMMPS installed and the plugin built (the adapter's check)
 
 DUMP = ("dump dropin all custom {every} dump.out id x y z vx vy vz fx fy fz omegax omegay omegaz\n"
         "dump_modify dropin sort id format float %.17g\n")

@@ -19,9 +19,9 @@ import pytest
 from stickslip import analysis, columns
 from stickslip import scene as scene_mod
 from stickslip.adapters import lammps as lammps_adapter
-from conftest import paper_case
+from conftest import needs_engine, paper_case
 
-needs_lammps = pytest.mark.skipif(lammps_adapter.available() is not None, reason=str(lammps_adapter.available()))
+needs_lammps = needs_engine("lammps")
 U = np.finfo(float).eps / 2  # unit round-off, 1.1e-16
 
 

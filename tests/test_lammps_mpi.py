@@ -28,9 +28,10 @@ import re
 import numpy as np
 import pytest
 
-from lammps_runs import EXAMPLES, STOCK, read_dump, rename_to_stickslip, require, run_lammps
+from conftest import needs_engine
+from lammps_runs import EXAMPLES, STOCK, read_dump, rename_to_stickslip, run_lammps
 
-require()
+pytestmark = needs_engine("lammps")  # LAMMPS installed and the plugin built (the adapter's check)
 
 LAW = "mu_k 0.45 reset spring"
 DUMP = "dump d all custom 1000 dump.out id x y z\ndump_modify d sort id format float %.17g\n"

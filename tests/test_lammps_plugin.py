@@ -19,10 +19,11 @@ import subprocess
 import numpy as np
 import pytest
 
-from lammps_runs import (CRASH_MARKERS, LIBRARY, LOADER, STOCK, error_lines, read_dump, read_thermo, require,
+from conftest import needs_engine
+from lammps_runs import (CRASH_MARKERS, LIBRARY, LOADER, STOCK, error_lines, read_dump, read_thermo, 
                          run_lammps)
 
-require()
+pytestmark = needs_engine("lammps")  # LAMMPS installed and the plugin built (the adapter's check)
 
 F17 = "%.17g"
 

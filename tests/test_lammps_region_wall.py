@@ -16,9 +16,10 @@ import re
 import numpy as np
 import pytest
 
-from lammps_runs import EXAMPLES, STOCK, error_lines, read_dump, require, run_lammps
+from conftest import needs_engine
+from lammps_runs import EXAMPLES, STOCK, error_lines, read_dump, run_lammps
 
-require()
+pytestmark = needs_engine("lammps")  # LAMMPS installed and the plugin built (the adapter's check)
 
 STYLE = "wall/gran/region/stickslip"
 DUMP = ("dump d all custom {every} dump.out id x y z vx vy vz fx fy fz omegax omegay omegaz\n"

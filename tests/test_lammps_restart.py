@@ -25,9 +25,10 @@ import pytest
 
 import conftest
 
-from lammps_runs import STOCK, read_dump, require, run_lammps
+from conftest import needs_engine
+from lammps_runs import STOCK, read_dump, run_lammps
 
-require()
+pytestmark = needs_engine("lammps")  # LAMMPS installed and the plugin built (the adapter's check)
 
 F17 = "%.17g"
 
