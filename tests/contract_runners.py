@@ -5,11 +5,7 @@ contact recorded at the end of each step: {"fn": (N,), "F": (N, 3) force on i,
 
 A new engine is one more function here and one entry in RUNNERS (the test fails for an
 engine of stickslip.adapters.ENGINES that has neither an entry nor a reason in
-SHARED_KERNEL). The LAMMPS styles (pair_style gran/hooke/stickslip, fix wall/gran/stickslip)
-need: per-step output of one contact's spring D, Fn, applied tangential force and slip
-count at %.17g (LIGGGHTS: `stick_slip_record on`), the reset and slip-timing options,
-mu_s and mu_k per type pair, and a way to hold grains still (no time integration) or
-turn them rigidly (`fix move`).
+SHARED_KERNEL). An engine whose record has no spring returns "D": None (LAMMPS).
 """
 from __future__ import annotations
 
@@ -309,20 +305,19 @@ def run_liggghts_type_pairs(timing="step"):
 # the step number), so its changes of state happen inside a step, as on the other engines;
 # a new `run` would evaluate every contact once more in its set-up (no time passes, but a
 # slip there resets the spring uncounted). Only a rigid turn needs `fix move rotate` (it
-# also sets the spins) and so a `run` of its own; the set-up before it sees the other rows
-# in the state their last step left, which the set-up leaves as it is (no row is at or
-# above its threshold at the end of a step, apart from the sliding ones, whose reset gives
-# the same spring again).
+# also sets the spins) and so a `run` of its own; the set-up before it sees the pair batch's
+# other row (the re-contact) in the state its last step left, sticking at 4 w of T = 24 w,
+# which a set-up leaves as it is.
 
 def lammps_coefficients(case):
     """The pair style's or wall's stock arguments: Kn Kt nu_n nu_s mu_s dampflag limit_damping."""
     return f"{_f(lc.KN)} {_f(lc.KS)} {_f(case.nu_n)} {_f(case.nu_s)} {_f(case.mu_s)} 1 limit_damping"
 
 
-def lammps_keywords(case):
-    """The law's keywords for a case (docs/law.md's rules, the record on)."""
+def lammps_keywords(case, record=True):
+    """The law's keywords for a case (docs/law.md's rules), the record on or off."""
     return (f"mu_k {_f(case.mu_k)} reset {case.reset} slip_timing {case.timing} history_rotation keep_length "
-            "damping absolute lever_arm contact record yes")
+            f"damping absolute lever_arm contact record {'yes' if record else 'no'}")
 
 
 def _piecewise(spans):
@@ -479,20 +474,22 @@ def run_lammps(case):
     return _LAMMPS_TRACES[key][case.name]
 
 
-def run_lammps_type_pairs(timing="step"):
+def lammps_type_pairs(timing="step", nu_s=0.0, record=True):
     """Six grain pairs side by side, one per pair of types 1..3, each with its own mu_s, mu_k
     from pair_coeff (law_contract.TYPE_PAIRS; LAMMPS' wall has one mu_s and mu_k per fix, so
-    type 1 is a grain type here and (1, 1) a pair too). Pairs with a grain of type 1 have
-    their normal along y and slide along x, the others normal x, sliding along y (the
-    directions test_coefficients_per_type_pair expects). Returns {type pair: trace}."""
+    type 1 is a grain type here and (1, 1) a pair too), grain i sliding at one X a step.
+    Pairs with a grain of type 1 have their normal along y and slide along x, the others
+    normal x, sliding along y (the directions test_coefficients_per_type_pair expects).
+    Runs lc.TYPE_PAIR_STEPS steps; returns {type pair: (steps, k) array}, each step's
+    compute pair/local values for the contact, as the force on i: with record, Fn (p11),
+    F_s (p1-p3), slips (p12); without, p1-p3 (the force single() re-evaluates)."""
     import lammps_runs
 
     coeff = lc.type_pair_coefficients()
     d = 2 * lc.R - lc.DELTA
+    law = lc.Case("", "", "pair", (), 0.5, 0.5, nu_s=nu_s, timing=timing)  # (every pair's mu from pair_coeff)
     lines = [LAMMPS_HEAD.format(ntypes=3, dt=_f(lc.DT)),
-             "pair_style gran/hooke/stickslip " + lammps_coefficients(lc.Case("", "", "pair", (), 0.5, 0.5))
-             + f" slip_timing {timing} reset spring history_rotation keep_length damping absolute lever_arm contact "
-             "record yes",
+             f"pair_style gran/hooke/stickslip {lammps_coefficients(law)} {lammps_keywords(law, record)}",
              "pair_coeff * *"]
     lines += [f"pair_coeff {i} {j} mu_s {_f(ms)} mu_k {_f(mk)}" for (i, j), (ms, mk) in coeff.items()]
     first = {}
@@ -506,9 +503,12 @@ def run_lammps_type_pairs(timing="step"):
                       f"set atom {2 * k + b + 1} diameter {_f(2 * lc.R)} density 1000 "
                       f"vx {_f(v[0])} vy {_f(v[1])} vz {_f(v[2])}"]
         first[(ti, tj)] = 2 * k + 1
-    lines += ["compute pl all pair/local p11 p1 p2 p3 p12 cutoff radius",
+    columns = (11, 1, 2, 3, 12) if record else (1, 2, 3)
+    forces = [columns.index(1) + c for c in range(3)]
+    lines += [f"compute pl all pair/local {' '.join(f'p{c}' for c in columns)} cutoff radius",
               "compute ids all property/local patom1 patom2 cutoff radius",
-              "dump p all local 1 dump.pairs c_ids[1] c_ids[2] " + " ".join(f"c_pl[{c}]" for c in range(1, 6)),
+              "dump p all local 1 dump.pairs c_ids[1] c_ids[2] " + " ".join(
+                  f"c_pl[{c}]" for c in range(1, len(columns) + 1)),
               "dump_modify p format float %.17g", f"run {lc.TYPE_PAIR_STEPS}"]
     with tempfile.TemporaryDirectory(prefix="contract-lammps-") as tmp:
         work = Path(tmp)
@@ -516,14 +516,24 @@ def run_lammps_type_pairs(timing="step"):
         pairs = lammps_runs.read_dump(work / "dump.pairs")
     out = {}
     for pair, a in first.items():
-        tr = _empty(lc.TYPE_PAIR_STEPS)
-        tr["D"] = None  # not in LAMMPS' record
+        rows = []
         for s in range(lc.TYPE_PAIR_STEPS):
             r = next(r for r in pairs[s + 1] if {int(r[0]), int(r[1])} == {a, a + 1})
-            row = r[2:7].copy()
-            if int(r[0]) != a:  # the record is the force on patom1: here j
-                row[1:4] = -row[1:4]
-            tr["fn"][s], tr["F"][s], tr["slips"][s] = row[0], row[1:4], int(row[4])
+            row = r[2:].copy()
+            if int(r[0]) != a:  # the values are the force on patom1: here j
+                row[forces] = -row[forces]
+            rows.append(row)
+        out[pair] = np.array(rows)
+    return out
+
+
+def run_lammps_type_pairs(timing="step"):
+    """lammps_type_pairs with the record: {type pair: trace}."""
+    out = {}
+    for pair, rows in lammps_type_pairs(timing).items():
+        tr = _empty(lc.TYPE_PAIR_STEPS)
+        tr["D"] = None  # not in LAMMPS' record
+        tr["fn"], tr["F"], tr["slips"] = rows[:, 0], rows[:, 1:4], rows[:, 4].astype(int)
         out[pair] = tr
     return out
 
