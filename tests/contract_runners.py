@@ -309,6 +309,10 @@ def run_liggghts_type_pairs(timing="step"):
 # other row (the re-contact) in the state its last step left, sticking at 4 w of T = 24 w,
 # which a set-up leaves as it is.
 
+# compute pair/local's record (lammps_plugin/README.md): Fn, F_s on patom1, slips
+RECORD_COLUMNS = (11, 1, 2, 3, 12)
+
+
 def lammps_coefficients(case):
     """The pair style's or wall's stock arguments: Kn Kt nu_n nu_s mu_s dampflag limit_damping."""
     return f"{_f(lc.KN)} {_f(lc.KS)} {_f(case.nu_n)} {_f(case.nu_s)} {_f(case.mu_s)} 1 limit_damping"
@@ -384,11 +388,8 @@ def _lammps_batch_script(cases):
             lines.append(f"variable {q}{k} equal {_piecewise(s)}")
         lines.append(f"fix mv{k} i{k} move variable " + " ".join(f"v_{q}{k}" for q in spans))
     if pair:
-        lines += ["compute pl all pair/local p11 p1 p2 p3 p12 cutoff radius",
-                  "compute ids all property/local patom1 patom2 cutoff radius",
-                  "dump p all local 1 dump.pairs c_ids[1] c_ids[2] " + " ".join(f"c_pl[{c}]" for c in range(1, 6)),
-                  "dump_modify p format float %.17g",
-                  "dump x all custom 1 dump.atoms id x y z", "dump_modify x format float %.17g sort id"]
+        lines += lammps_pair_local(RECORD_COLUMNS)
+        lines += ["dump x all custom 1 dump.atoms id x y z", "dump_modify x format float %.17g sort id"]
     done = 0
     for start in sorted(turns):
         lines.append(f"run {start - done}")
@@ -424,19 +425,37 @@ def _lammps_batch(cases):
                 row = records[k][s + 1][0][1:]
                 normal = np.array([0.0, 0.0, -1.0])
             else:
-                rows = [r for r in pairs.get(s + 1, []) if {int(r[0]), int(r[1])} == {a, a + 1}]
-                if not rows:
+                row = lammps_pair_row(pairs.get(s + 1, []), a, [1, 2, 3])
+                if row is None:
                     continue  # apart
-                r = rows[0]
-                row = r[2:7].copy()
-                if int(r[0]) != a:  # the record is the force on patom1: here j
-                    row[1:4] = -row[1:4]
                 xs = atoms[s + 1]
                 d = xs[a][1:4] - xs[a - 1][1:4]
                 normal = d / np.linalg.norm(d)
             tr["fn"][s], tr["F"][s], tr["slips"][s], tr["n"][s] = row[0], row[1:4], int(row[4]), normal
         out[case.name] = tr
     return out
+
+
+def lammps_pair_local(columns):
+    """Input lines: compute pair/local's `columns` (p numbers) of every contact, each step,
+    after its atom ids, at %.17g into dump.pairs."""
+    return [f"compute pl all pair/local {' '.join(f'p{c}' for c in columns)} cutoff radius",
+            "compute ids all property/local patom1 patom2 cutoff radius",
+            "dump p all local 1 dump.pairs c_ids[1] c_ids[2] " + " ".join(
+                f"c_pl[{k}]" for k in range(1, len(columns) + 1)),
+            "dump_modify p format float %.17g"]
+
+
+def lammps_pair_row(frame, a, forces):
+    """The values of the contact between atoms a and a+1 in one step of dump.pairs (None:
+    apart), the `forces` columns turned into the force on a (they are on patom1)."""
+    rows = [r for r in frame if {int(r[0]), int(r[1])} == {a, a + 1}]
+    if not rows:
+        return None
+    row = rows[0][2:].copy()
+    if int(rows[0][0]) != a:
+        row[forces] = -row[forces]
+    return row
 
 
 def _first_atom(case, k):
@@ -503,28 +522,15 @@ def lammps_type_pairs(timing="step", nu_s=0.0, record=True):
                       f"set atom {2 * k + b + 1} diameter {_f(2 * lc.R)} density 1000 "
                       f"vx {_f(v[0])} vy {_f(v[1])} vz {_f(v[2])}"]
         first[(ti, tj)] = 2 * k + 1
-    columns = (11, 1, 2, 3, 12) if record else (1, 2, 3)
+    columns = RECORD_COLUMNS if record else (1, 2, 3)
     forces = [columns.index(1) + c for c in range(3)]
-    lines += [f"compute pl all pair/local {' '.join(f'p{c}' for c in columns)} cutoff radius",
-              "compute ids all property/local patom1 patom2 cutoff radius",
-              "dump p all local 1 dump.pairs c_ids[1] c_ids[2] " + " ".join(
-                  f"c_pl[{c}]" for c in range(1, len(columns) + 1)),
-              "dump_modify p format float %.17g", f"run {lc.TYPE_PAIR_STEPS}"]
+    lines += lammps_pair_local(columns) + [f"run {lc.TYPE_PAIR_STEPS}"]
     with tempfile.TemporaryDirectory(prefix="contract-lammps-") as tmp:
         work = Path(tmp)
         lammps_runs.run_lammps(work, "types", "\n".join(lines) + "\n")
         pairs = lammps_runs.read_dump(work / "dump.pairs")
-    out = {}
-    for pair, a in first.items():
-        rows = []
-        for s in range(lc.TYPE_PAIR_STEPS):
-            r = next(r for r in pairs[s + 1] if {int(r[0]), int(r[1])} == {a, a + 1})
-            row = r[2:].copy()
-            if int(r[0]) != a:  # the values are the force on patom1: here j
-                row[forces] = -row[forces]
-            rows.append(row)
-        out[pair] = np.array(rows)
-    return out
+    return {pair: np.array([lammps_pair_row(pairs[s + 1], a, forces) for s in range(lc.TYPE_PAIR_STEPS)])
+            for pair, a in first.items()}
 
 
 def run_lammps_type_pairs(timing="step"):

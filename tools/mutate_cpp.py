@@ -2,12 +2,12 @@
 """Small deliberate bugs in the C++ law, each built and run against the tests: does the
 suite see it? (issue 31 item 5; the README's test section quotes the last result.)
 
-    .venv/bin/python tools/mutate_cpp.py [--engine liggghts] [--only ID ...] [--wide]
+    .venv/bin/python tools/mutate_cpp.py [--engine liggghts|lammps] [--only ID ...] [--wide]
 
 For each mutant: copy the engine's source folder into build/mutants/<engine>/src (the
 repository's files are never touched), apply the mutant to the copy, rebuild in
 build/mutants/<engine>/build, and run the engine's test selection with the adapter
-pointed at that build (STICKSLIP_LIGGGHTS_BUILD). A mutant is found by the text it
+pointed at that build (STICKSLIP_LIGGGHTS_BUILD, STICKSLIP_LAMMPS_BUILD). A mutant is found by the text it
 changes (a regular expression, whitespace-insensitive, that must match exactly `count`
 times), never by line number: a mutant whose text is not found, or found a different
 number of times, is an ERROR in the summary and makes the exit status 2, never a silent
@@ -20,9 +20,10 @@ build (3x quicker to compile than the project's; the same IEEE operations withou
 contraction, so the same numbers: the baseline must pass it first), the wide one on a
 Release build as ./run.sh setup makes it (the large scenes run 3-5x faster there).
 
-A third engine (LAMMPS) is one more entry in ENGINES: its source folder, the file the
-law lives in, the environment variable its adapter reads, its test selections, and its
-mutants (the same kinds, found in its own text).
+An engine is one entry in ENGINES: its source folder, the file the law lives in (a mutant
+may name another file of the folder), the environment variable its adapter reads, its
+test selections, its configure arguments, and its mutants (the same kinds, found in its
+own text).
 """
 from __future__ import annotations
 
