@@ -305,9 +305,10 @@ def run_liggghts_type_pairs(timing="step"):
 # the step number), so its changes of state happen inside a step, as on the other engines;
 # a new `run` would evaluate every contact once more in its set-up (no time passes, but a
 # slip there resets the spring uncounted). Only a rigid turn needs `fix move rotate` (it
-# also sets the spins) and so a `run` of its own; the set-up before it sees the pair batch's
-# other row (the re-contact) in the state its last step left, sticking at 4 w of T = 24 w,
-# which a set-up leaves as it is.
+# also sets the spins) and so a `run` of its own; the set-up before it sees every row of the
+# pair batch in the state its last step left, all sticking (the turning rows at 4 w of
+# T = 32 w, the re-contact at 4 w of 24 w), which a set-up leaves as it is. (A row that is
+# at or above its threshold at a turn's start would need a process of its own.)
 
 # compute pair/local's record (lammps_plugin/README.md): Fn, F_s on patom1, slips
 RECORD_COLUMNS = (11, 1, 2, 3, 12)
@@ -353,7 +354,7 @@ def _lammps_batch_script(cases):
     if pair:
         lines += [f"pair_style gran/hooke/stickslip {lammps_coefficients(cases[0])} {lammps_keywords(cases[0])}",
                   "pair_coeff * *"]
-    turns = {}  # step the turn begins after -> [(k, segment)]
+    turns = {}  # the step a turn begins after -> [(k, its segment, its centre)]
     for k, case in enumerate(cases):
         a = _first_atom(case, k)
         base = np.array([4.0 * (k % 7) - 12.0, 4.0 * (k // 7) - 12.0, 0.0])
@@ -395,7 +396,8 @@ def _lammps_batch_script(cases):
         lines.append(f"run {start - done}")
         for k, seg, base in turns[start]:
             period = 2 * math.pi / seg.omega
-            lines += [f"unfix mv{k}", f"group g{k} id {2 * k + 1} {2 * k + 2}",  # (a pair's atoms)
+            a = _first_atom(cases[k], k)
+            lines += [f"unfix mv{k}", f"group g{k} id {a} {a + 1}",
                       f"fix turn{k} g{k} move rotate {_f(base[0])} {_f(base[1])} {_f(base[2])} 0 0 1 {_f(period)}"]
         done = start
     lines.append(f"run {max(c.steps for c in cases) - done}")
