@@ -183,8 +183,9 @@ LAMMPS_MUTANTS = (
            "const double kept = reset_total ? 0.0 : nu_s * speed;", "const double kept = nu_s * speed;", file=EXACT_H),
     Mutant("recontact_keeps_spring_pair", "re-contact does not start from a zero spring",
            "for (int m = 0; m < dnum; m++) hist[m] = 0.0; continue;", "continue;", file=PAIR_CPP),
+    # (the end of the statement only: the LAMMPS speed work renames the history array)
     Mutant("recontact_keeps_spring_wall", "re-contact does not start from a zero spring",
-           "for (int m = 0; m < size_history; m++) history_one[i][m] = 0.0; continue;", "continue;", file=WALL_CPP),
+           "[m] = 0.0; continue;", "[m] += 0.0; continue;", file=WALL_CPP),
     Mutant("fn_signed", "|Fn| for a tensile Fn",
            "const double fnabs = std::fabs(ccel_r);", "const double fnabs = ccel_r;"),
 )
