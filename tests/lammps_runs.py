@@ -15,8 +15,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from stickslip.adapters import lammps as lammps_adapter
+
 ROOT = Path(__file__).resolve().parent.parent
-BUILD = ROOT / "build" / "lammps_plugin"
+BUILD = lammps_adapter.BUILD  # (STICKSLIP_LAMMPS_BUILD: another build, tools/mutate_cpp.py)
 LAUNCHER = BUILD / "lmp-stickslip"
 LIBRARY = BUILD / "libstickslip_lammps.so"
 LOADER = BUILD / "stickslip.lmp"

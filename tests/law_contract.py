@@ -313,7 +313,11 @@ def check_turning(case, trace):
     d0 = 4 * X
     loaded = case.segments[0].steps
     turn = case.segments[1]
-    D, normal = trace["D"], trace["n"]
+    normal = trace["n"]
+    # an engine whose record has no spring (LAMMPS): here F = -Ks D - nu_s V_s with nu_s = 0
+    # and Ks = 1, so -F is D to the last bit (a negation and a division by 1)
+    assert case.nu_s == 0 and KS == 1.0
+    D = trace["D"] if trace["D"] is not None else -trace["F"] / KS
     assert np.allclose(np.linalg.norm(D[loaded - 1]), d0, rtol=0, atol=4 * EPS * d0)
     bound_per_step = 8 * EPS * d0 + 4 * EPS * abs(turn.omega) * (2 * R) * DT
     for k in range(loaded, len(D)):
@@ -346,11 +350,12 @@ def compare(case, trace):
                 continue
             F, D = -vector(e.f, w), vector(e.d, w)
             tol = case.ulps * np.spacing(max(np.abs(F).max(), np.abs(D).max()))
-            got = {q: trace[q][k] for q in ("fn", "F", "D", "slips")}
+            got = {q: None if trace[q] is None else trace[q][k] for q in ("fn", "F", "D", "slips")}
             where = f"{case.name}: step {k + 1}"
             assert got["fn"] == e.fn, (where, "Fn", got["fn"], e.fn)
             assert np.all(np.abs(got["F"] - F) <= tol), (where, "force", got["F"], F)
-            assert np.all(np.abs(got["D"] - D) <= tol), (where, "spring", got["D"], D)
+            if got["D"] is not None:  # (None: the engine's record has no spring; see contract_runners)
+                assert np.all(np.abs(got["D"] - D) <= tol), (where, "spring", got["D"], D)
             assert got["slips"] == e.slips, (where, "slips since the contact began", got["slips"], e.slips)
         k0 += seg.steps
 
@@ -383,5 +388,6 @@ def compare_type_pair(pair, trace, w):
         where = f"types {pair}: step {k + 1}"
         assert trace["fn"][k] == e.fn, (where, trace["fn"][k])
         assert np.all(np.abs(trace["F"][k] - F) <= tol), (where, "force", trace["F"][k], F)
-        assert np.all(np.abs(trace["D"][k] - D) <= tol), (where, "spring", trace["D"][k], D)
+        if trace["D"] is not None:  # (None: the engine's record has no spring)
+            assert np.all(np.abs(trace["D"][k] - D) <= tol), (where, "spring", trace["D"][k], D)
         assert trace["slips"][k] == e.slips, (where, "slips", trace["slips"][k], e.slips)

@@ -210,6 +210,34 @@ def test_every_type_pair_has_its_own_coefficients(tmp_path):
     assert held_first == [False, True], "the contacts must change lists (transfer_history)"
 
 
+def test_pair_local_without_record_caps_at_each_pairs_own_threshold():
+    """Without `record`, compute pair/local's p1-p3 re-evaluate the force from the stored
+    spring (single(): trial force, brought to Fmin at or above mu_s Fn), with the contact's
+    own type pair's coefficients. The contract's six type pairs (tests/law_contract.py,
+    Fn = 1, one X a step, step timing, reset spring) with a dashpot nu_s V = 7 X: before
+    the first slip the spring holds k X after step k, and the re-evaluation is the applied
+    force k + 7; the first slip comes where k + 7 reaches T (k = T - 7); from then on every
+    step slips (Fmin + 1 + 7 >= T, since T - Fmin = 6 for every pair), the spring is Fmin and
+    its re-evaluation Fmin + 7 >= T is brought back to Fmin. A pair read with another pair's
+    coefficients (a larger T) reports Fmin + 7 instead. ~0.4 s."""
+    import law_contract as lc
+    from contract_runners import lammps_type_pairs
+
+    dashpot = 7  # nu_s V in X: nu_s = 7/16, V = 1/4 = X/dt
+    rows = lammps_type_pairs("step", nu_s=dashpot * lc.X / 0.25, record=False)
+    assert set(rows) == set(lc.TYPE_PAIRS)
+    for pair, got in rows.items():
+        t, fmin = lc.TYPE_PAIRS[pair]
+        assert t - fmin <= dashpot and t - dashpot >= 1, "the derivation above needs these"
+        w = lc.X * (np.array([1.0, 0, 0]) if 1 in pair else np.array([0, 1.0, 0]))
+        for k in range(1, lc.TYPE_PAIR_STEPS + 1):
+            f = k + dashpot if k < t - dashpot else fmin
+            # exact before the first slip; after it Fmin/|F| F: sqrt(F.F) = |F| exactly for a
+            # force along one axis, then a quotient and a product: within 1 ulp
+            tol = np.spacing(f * lc.X)
+            assert np.all(np.abs(got[k - 1] + f * w) <= tol), (pair, k, got[k - 1] / lc.X, -f)
+
+
 def type_pairs_script(coeffs, newton, extra=""):
     p = DRAG
     rest = 2 * p["r"] - p["mass"] * p["g"] / p["kn"]

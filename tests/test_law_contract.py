@@ -34,7 +34,8 @@ def test_coefficients_per_type_pair(engine, timing):
     left (E3, E7), which is the step timing's result."""
     skip_engine(engine)
     traces = runners.TYPE_PAIR_RUNNERS[engine](timing)
-    assert set(traces) == set(lc.TYPE_PAIRS) - {(1, 1)}
+    # (1, 1) is the wall's own type on LIGGGHTS (no contact); LAMMPS' grains use all three
+    assert set(lc.TYPE_PAIRS) - {(1, 1)} <= set(traces) <= set(lc.TYPE_PAIRS)
     for pair, trace in traces.items():
         w = lc.X * (np.array([1.0, 0, 0]) if 1 in pair else np.array([0, 1.0, 0]))
         lc.compare_type_pair(pair, trace, w)

@@ -2,12 +2,12 @@
 """Small deliberate bugs in the C++ law, each built and run against the tests: does the
 suite see it? (issue 31 item 5; the README's test section quotes the last result.)
 
-    .venv/bin/python tools/mutate_cpp.py [--engine liggghts] [--only ID ...] [--wide]
+    .venv/bin/python tools/mutate_cpp.py [--engine liggghts|lammps] [--only ID ...] [--wide]
 
 For each mutant: copy the engine's source folder into build/mutants/<engine>/src (the
 repository's files are never touched), apply the mutant to the copy, rebuild in
 build/mutants/<engine>/build, and run the engine's test selection with the adapter
-pointed at that build (STICKSLIP_LIGGGHTS_BUILD). A mutant is found by the text it
+pointed at that build (STICKSLIP_LIGGGHTS_BUILD, STICKSLIP_LAMMPS_BUILD). A mutant is found by the text it
 changes (a regular expression, whitespace-insensitive, that must match exactly `count`
 times), never by line number: a mutant whose text is not found, or found a different
 number of times, is an ERROR in the summary and makes the exit status 2, never a silent
@@ -20,9 +20,10 @@ build (3x quicker to compile than the project's; the same IEEE operations withou
 contraction, so the same numbers: the baseline must pass it first), the wide one on a
 Release build as ./run.sh setup makes it (the large scenes run 3-5x faster there).
 
-A third engine (LAMMPS) is one more entry in ENGINES: its source folder, the file the
-law lives in, the environment variable its adapter reads, its test selections, and its
-mutants (the same kinds, found in its own text).
+An engine is one entry in ENGINES: its source folder, the file the law lives in (a mutant
+may name another file of the folder), the environment variable its adapter reads, its
+test selections, its configure arguments, and its mutants (the same kinds, found in its
+own text).
 """
 from __future__ import annotations
 
@@ -47,6 +48,7 @@ class Mutant:
     find: str  # the text to change (whitespace-insensitive)
     replace: str
     count: int = 1  # how many times `find` must occur (all are changed)
+    file: str = ""  # the file mutated, inside the engine's source ("": the engine's law_file)
 
 
 @dataclass(frozen=True)
@@ -57,6 +59,7 @@ class Engine:
     fast: tuple  # pytest arguments: the selection every mutant runs
     wide: tuple  # the engine's default-suite tests, for mutants the fast one misses
     mutants: tuple
+    cmake_args: tuple = ()  # configure arguments beyond the build type
 
 
 LIGGGHTS_MUTANTS = (
@@ -107,11 +110,84 @@ LIGGGHTS_MUTANTS = (
     Mutant("reset_total_ignored_exact", "the reset rule `total` ignored",
            "const double kept = reset_total ? 0.0 : gammat * speed;", "const double kept = gammat * speed;"),
     Mutant("recontact_keeps_spring", "re-contact does not start from a zero spring",
-           "if (fresh) D[0] = D[1] = D[2] = 0.0;", ""),
+           "STICK_SLIP_COUNT(STAMP_FRESH); D[0] = D[1] = D[2] = 0.0;", "STICK_SLIP_COUNT(STAMP_FRESH);"),
     Mutant("wall_close_keeps_spring", "re-contact does not start from a zero spring",
            "hist[0] = hist[1] = hist[2] = 0.0;", ""),
     Mutant("fn_signed", "|Fn| for a tensile Fn",
            "const double fn = std::fabs(sidata.Fn);", "const double fn = sidata.Fn;"),
+)
+
+# LAMMPS: the law is stick_slip_law.h (steps 3-5, the inline E4 of the exact timing),
+# exact_slip_timing.h (E1-E7), and the pair style's and wall's code around it (coefficients
+# per type pair, the history dropped when a contact ends). Every `find` is a statement of
+# the law as it reads, long enough to be found once.
+LAW_H, EXACT_H, PAIR_CPP, WALL_CPP = ("stick_slip_law.h", "exact_slip_timing.h", "pair_gran_hooke_stickslip.cpp",
+                                      "fix_wall_gran_stickslip.cpp")
+LAMMPS_MUTANTS = (
+    Mutant("fmin_step_0.3pct", "Fmin off by 0.3 %",
+           "const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;",
+           "const double ratio = sum > 0.0 ? c.kin * fnabs * 1.003 / std::sqrt(sum) : 0.0;"),
+    Mutant("fmin_exact_0.3pct", "Fmin off by 0.3 %",
+           "limit = c.mu_s * fnabs, fmin = c.kin * fnabs;", "limit = c.mu_s * fnabs, fmin = c.kin * fnabs * 1.003;"),
+    Mutant("threshold_gt_step", "> for >= at the threshold",
+           "bool slipped = sum >= limit * limit;", "bool slipped = sum > limit * limit;"),
+    Mutant("threshold_gt_exact_start", "> for >= at the threshold",
+           "slipped = slipped || start2 >= limit * limit;", "slipped = slipped || start2 > limit * limit;"),
+    Mutant("threshold_gt_exact_e4", "> for >= at the threshold",
+           "if (start2 >= limit * limit && limit > 0.0 && !s.reset_total",
+           "if (start2 > limit * limit && limit > 0.0 && !s.reset_total"),
+    Mutant("threshold_gt_exact_loop", "> for >= at the threshold",
+           "if (slips == 0 && F2 >= T * T)", "if (slips == 0 && F2 > T * T)", file=EXACT_H),
+    Mutant("reset_spring_sign", "sign error in the spring reset",
+           "for (int k = 0; k < 3; k++) D[k] = -fs[k] / kt;", "for (int k = 0; k < 3; k++) D[k] = fs[k] / kt;"),
+    Mutant("reset_total_sign", "sign error in the spring reset",
+           "D[k] = ratio * (D[k] + dv) - dv;", "D[k] = ratio * (D[k] + dv) + dv;"),
+    Mutant("reset_exact_end_sign", "sign error in the spring reset",
+           "D[k] = -(trial[k] + nu_s * vtr[k]) / kt;", "D[k] = -(trial[k] - nu_s * vtr[k]) / kt;"),
+    Mutant("reset_exact_e4_sign", "sign error in the spring reset",
+           "D[k] = akt * vtr[k];", "D[k] = -akt * vtr[k];"),
+    Mutant("dashpot_sign", "sign error in the dashpot",
+           "fs[0] = -(kt * D[0] + nu_s * vtr[0]); fs[1] = -(kt * D[1] + nu_s * vtr[1]); "
+           "fs[2] = -(kt * D[2] + nu_s * vtr[2]);",
+           "fs[0] = -(kt * D[0] - nu_s * vtr[0]); fs[1] = -(kt * D[1] - nu_s * vtr[1]); "
+           "fs[2] = -(kt * D[2] - nu_s * vtr[2]);"),
+    Mutant("exact_start_sign", "sign error in the trial force at the step's start (exact timing)",
+           "{fs[0] + ktdt * vtr[0], fs[1] + ktdt * vtr[1], fs[2] + ktdt * vtr[2]}",
+           "{fs[0] - ktdt * vtr[0], fs[1] - ktdt * vtr[1], fs[2] - ktdt * vtr[2]}"),
+    Mutant("turn_loses_length", "a turned history that loses its length",
+           "scale = new2 > 0.0 ? std::sqrt(old2 / new2) : 1.0;", "scale = 1.0;"),
+    Mutant("turn_series_loses_length", "a turned history that loses its length",
+           "double scale = 1.0 + x * (0.5 + 0.375 * x);", "double scale = 1.0;"),
+    Mutant("exact_misses_whole_cycles", "exact timing that misses a slip inside the step",
+           "const double n = std::floor(rest / L);", "const double n = 0.0;", file=EXACT_H),
+    Mutant("exact_misses_slip_at_start", "exact timing that misses a slip inside the step",
+           "slipped = slipped || start2 >= limit * limit;", "slipped = slipped;"),
+    Mutant("exact_slip_late", "exact timing that misses a slip inside the step",
+           "dtheta = rate > 0.0 ? gap / rate : INFINITY;", "dtheta = rate > 0.0 ? 1.5 * gap / rate : INFINITY;",
+           file=EXACT_H),
+    Mutant("coeffs_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
+           "tangential_force<Mode>(s, coeffs_i[type[j]],", "tangential_force<Mode>(s, coeffs_i[type[i]],",
+           file=PAIR_CPP),
+    Mutant("mu_s_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
+           "mu_s = mu_s_given[i][j] >= 0.0 ? mu_s_given[i][j] : xmu;",
+           "mu_s = mu_s_given[j][j] >= 0.0 ? mu_s_given[j][j] : xmu;", file=PAIR_CPP),
+    Mutant("mu_k_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
+           "mu_k = mu_k_given[i][j] >= 0.0 ? mu_k_given[i][j] :",
+           "mu_k = mu_k_given[i][i] >= 0.0 ? mu_k_given[i][i] :", file=PAIR_CPP),
+    Mutant("single_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
+           "const Coeffs &c = coeffs[itype][jtype];", "const Coeffs &c = coeffs[itype][itype];", file=PAIR_CPP),
+    Mutant("reset_total_ignored_step", "the reset rule `total` ignored",
+           "if (!s.reset_total) for (int k = 0; k < 3; k++) D[k] = -fs[k] / kt;",
+           "for (int k = 0; k < 3; k++) D[k] = -fs[k] / kt;"),
+    Mutant("reset_total_ignored_exact", "the reset rule `total` ignored",
+           "const double kept = reset_total ? 0.0 : nu_s * speed;", "const double kept = nu_s * speed;", file=EXACT_H),
+    Mutant("recontact_keeps_spring_pair", "re-contact does not start from a zero spring",
+           "for (int m = 0; m < dnum; m++) hist[m] = 0.0; continue;", "continue;", file=PAIR_CPP),
+    # (the end of the statement only: the LAMMPS speed work renames the history array)
+    Mutant("recontact_keeps_spring_wall", "re-contact does not start from a zero spring",
+           "[m] = 0.0; continue;", "[m] += 0.0; continue;", file=WALL_CPP),
+    Mutant("fn_signed", "|Fn| for a tensile Fn",
+           "const double fnabs = std::fabs(ccel_r);", "const double fnabs = ccel_r;"),
 )
 
 ENGINES = {
@@ -122,7 +198,15 @@ ENGINES = {
               "tests/test_stability_engines.py", "tests/test_drum.py", "tests/test_precision.py",
               "-k", "liggghts"),
         mutants=LIGGGHTS_MUTANTS),
-    # "lammps": Engine(source="lammps_plugin", law_file=..., build_env="STICKSLIP_LAMMPS_BUILD", ...),
+    "lammps": Engine(
+        source="lammps_plugin", law_file=LAW_H, build_env="STICKSLIP_LAMMPS_BUILD",
+        fast=("tests/test_law_contract.py", "-k", "lammps"),
+        wide=("tests/test_lammps_plugin.py", "tests/test_lammps_engine.py", "tests/test_lammps_dropin.py",
+              "tests/test_lammps_mpi.py", "tests/test_lammps_region_wall.py", "tests/test_lammps_restart.py",
+              "tests/test_stability_engines.py", "tests/test_translating_wall.py", "-k", "lammps"),
+        mutants=LAMMPS_MUTANTS,
+        # the LAMMPS headers ./run.sh setup extracted (CMakeLists' default is relative to its source)
+        cmake_args=(f"-DLAMMPS_HEADERS={REPO / 'build' / 'lammps_headers' / 'src'}",)),
 }
 
 
@@ -140,12 +224,13 @@ def apply(source: str, m: Mutant) -> str:
     return pattern(m.find).sub(lambda _: m.replace, source)
 
 
-def build(src: Path, out: Path, quick=True):
+def build(src: Path, out: Path, quick=True, cmake_args=()):
     """Configure (once) and build `src` into `out`: -O0 (quick) or Release."""
     if not (out / "CMakeCache.txt").exists():
         kind = ["-DCMAKE_BUILD_TYPE=MutantO0", "-DCMAKE_CXX_FLAGS_MUTANTO0=-O0"] if quick else \
             ["-DCMAKE_BUILD_TYPE=Release"]
-        subprocess.run(["cmake", "-S", str(src), "-B", str(out), *kind], check=True, capture_output=True, text=True)
+        subprocess.run(["cmake", "-S", str(src), "-B", str(out), *kind, *cmake_args], check=True, capture_output=True,
+                       text=True)
     proc = subprocess.run(["cmake", "--build", str(out), "-j", "2"], capture_output=True, text=True)
     return proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
 
@@ -173,8 +258,7 @@ def main(argv=None):
     if src.exists():
         shutil.rmtree(src)
     shutil.copytree(REPO / eng.source, src)
-    law = src / eng.law_file
-    original = law.read_text()
+    originals = {f: (src / f).read_text() for f in {m.file or eng.law_file for m in mutants}}
     env = dict(os.environ, **{eng.build_env: str(out)})
     env_release = dict(os.environ, **{eng.build_env: str(out_release)})
     t_start = time.perf_counter()
@@ -182,11 +266,14 @@ def main(argv=None):
     # every mutant's text must be found before anything is built
     results, texts = [], {}
     for m in mutants:
+        file = m.file or eng.law_file
         try:
-            texts[m.id] = apply(original, m)
+            texts[m.id] = (file, apply(originals[file], m))
         except ValueError as e:
-            results.append((m, "ERROR", str(e), 0.0))
-    ok, log = build(src, out)
+            results.append((m, "ERROR", f"{file}: {e}", 0.0))
+    quick = dict(cmake_args=eng.cmake_args)
+    release = dict(quick=False, cmake_args=eng.cmake_args)
+    ok, log = build(src, out, **quick)
     if not ok:
         sys.exit(f"mutate_cpp: the unmutated source does not build:\n{log}")
     passed, failed, secs, tail = run_tests(eng.fast, env, args.jobs)
@@ -197,16 +284,19 @@ def main(argv=None):
         for m in mutants:
             if m.id not in texts:
                 continue
-            law.write_text(texts[m.id])
+            for file, text in originals.items():  # (the last mutant's file back as it was)
+                (src / file).write_text(text)
+            file, text = texts[m.id]
+            (src / file).write_text(text)
             t0 = time.perf_counter()
-            ok, log = build(src, out)
+            ok, log = build(src, out, **quick)
             if not ok:
                 results.append((m, "killed", "does not compile", time.perf_counter() - t0))
                 continue
             passed, failed, _, _ = run_tests(eng.fast, env, args.jobs)
             verdict, by = ("killed", "fast: " + ", ".join(failed)) if not passed else ("survived", "")
             if args.wide or passed:
-                ok, log = build(src, out_release, quick=False)
+                ok, log = build(src, out_release, **release)
                 if not ok:
                     sys.exit(f"mutate_cpp: {m.id} builds at -O0 but not in Release:\n{log}")
                 wide_passed, wide_failed, _, _ = run_tests(eng.wide, env_release, args.jobs)
@@ -215,10 +305,11 @@ def main(argv=None):
             results.append((m, verdict, by, time.perf_counter() - t0))
             print(f"{m.id:28s} {verdict:8s} {time.perf_counter() - t0:5.0f} s  {by}", flush=True)
     finally:
-        law.write_text(original)
-        build(src, out)  # leave the copies built as the repository's source
+        for file, text in originals.items():
+            (src / file).write_text(text)
+        build(src, out, **quick)  # leave the copies built as the repository's source
         if out_release.exists():
-            build(src, out_release, quick=False)
+            build(src, out_release, **release)
     killed = sum(1 for _, v, _, _ in results if v == "killed")
     errors = [r for r in results if r[1] == "ERROR"]
     print(f"\n{args.engine}: {killed} of {len(results) - len(errors)} mutants killed, "

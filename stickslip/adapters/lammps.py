@@ -37,8 +37,9 @@ from .text_dumps import id_ranges, read_dump, slip_stats
 
 NAME = "lammps"
 REPO = Path(__file__).resolve().parents[2]
-# The plugin build (./run.sh setup). Defined here only.
-BUILD = REPO / "build" / "lammps_plugin"
+# The plugin build (./run.sh setup). Defined here only; STICKSLIP_LAMMPS_BUILD points it at
+# another build (tools/mutate_cpp.py: a mutant's).
+BUILD = Path(os.environ.get("STICKSLIP_LAMMPS_BUILD") or REPO / "build" / "lammps_plugin")
 LAUNCHER = BUILD / "lmp-stickslip"
 # A wall's per-atom record (lammps_plugin/README.md, `record yes`): column 1 the contact
 # flag, 9 Fn, 10-12 the tangential force on the grain, 13 the contact's slip count

@@ -56,9 +56,10 @@ from pathlib import Path
 
 from .. import callgrind
 from ..ratio_interval import ratio_interval
+from .lammps import BUILD
 
 ROOT = Path(__file__).resolve().parents[2]
-LAUNCHER = ROOT / "build" / "lammps_plugin" / "lmp-stickslip"
+LAUNCHER = BUILD / "lmp-stickslip"
 EXAMPLE = Path("/usr/share/lammps/examples/pour/in.pour")
 CACHE = ROOT / "build" / "lammps_bench"
 
