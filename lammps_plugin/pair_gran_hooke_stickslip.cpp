@@ -213,17 +213,7 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
   }
 
   // the contact loop compiled for this combination of the law's settings
-  const int mode = (law.exact ? 4 : 0) + (law.project ? 2 : 0) + (law.record ? 1 : 0);
-  switch (mode) {
-    case 0: contacts<FixedMode<false, false, false>>(); break;
-    case 1: contacts<FixedMode<false, false, true>>(); break;
-    case 2: contacts<FixedMode<false, true, false>>(); break;
-    case 3: contacts<FixedMode<false, true, true>>(); break;
-    case 4: contacts<FixedMode<true, false, false>>(); break;
-    case 5: contacts<FixedMode<true, false, true>>(); break;
-    case 6: contacts<FixedMode<true, true, false>>(); break;
-    default: contacts<FixedMode<true, true, true>>(); break;
-  }
+  with_fixed_mode(law, [this](auto mode) { contacts<decltype(mode)>(); });
   if (vflag_fdotr) virial_fdotr_compute();
 }
 
