@@ -150,12 +150,13 @@ inline Coeffs make_coeffs(double kt, double mu_s, double mu_k)
 /* exact_step's general case (E1-E7 through exact_slips). Out of line, and called on copies
    of its vectors: an address taken on exact_step's path would keep V_s, F0 and the force in
    memory for every contact, and the compiler would keep products it shares with the
-   sticking path (nu_s V_s) on the stack. F: out, the force applied; D: out, the spring. */
-__attribute__((noinline)) inline void exact_general(const Settings &s, const Coeffs &c, double fnabs,
+   sticking path (nu_s V_s) on the stack. limit = T = mu_s |Fn|, fmin = Fmin (exact_step's);
+   F: out, the force applied; D: out, the spring. */
+__attribute__((noinline)) inline void exact_general(const Settings &s, const Coeffs &c, double limit, double fmin,
                                                     const double *vtr, double nu_s, double dt, const double *F0,
                                                     double *F, double *D)
 {
-  const double kt = c.kt, limit = c.mu_s * fnabs, fmin = c.kin * fnabs;
+  const double kt = c.kt;
   // E6 applies when nothing is added at the reset (reset total, or no dashpot)
   const bool flow_law = c.ratio == 1.0 && (s.reset_total || nu_s == 0.0);
   double applied[3], trial[3], stick;
@@ -199,7 +200,7 @@ __attribute__((always_inline)) inline void exact_step(const Settings &s, const C
   // the general case: on copies (exact_general)
   const double v[3] = {vtr[0], vtr[1], vtr[2]}, f0[3] = {F0[0], F0[1], F0[2]};
   double f[3], d[3];
-  exact_general(s, c, fnabs, v, nu_s, dt, f0, f, d);
+  exact_general(s, c, limit, fmin, v, nu_s, dt, f0, f, d);
   for (int k = 0; k < 3; k++) {
     F[k] = f[k];
     D[k] = d[k];

@@ -52,7 +52,7 @@ MARKERS = {
     ("stick_slip_law.h", "if (start2 >= limit * limit && limit > 0.0 && !s.reset_total"):
         "exact: a slip in the step (E4 tested)",
     ("stick_slip_law.h", "F[k] = -a * vtr[k];"): "exact: E4 at the step's start (slides)",
-    ("stick_slip_law.h", "exact_general(s, c, fnabs, v, nu_s, dt, f0, f, d);"): "exact: general case",
+    ("stick_slip_law.h", "exact_general(s, c, limit, fmin, v, nu_s, dt, f0, f, d);"): "exact: general case",
     ("exact_slip_timing.h", "const double speed = std::sqrt(dot3(vs, vs));"): "exact_slips: every call",
     ("exact_slip_timing.h", "applied[k] = 0.0;"): "E1 (Fn = 0)",
     ("exact_slip_timing.h", "const double f = dot3(F, u), F2 = dot3(F, F);"): "E2 (next slip sought)",
