@@ -172,9 +172,9 @@ __attribute__((noinline)) inline void exact_general(const Settings &s, const Coe
 /* Exact slip timing (docs/law.md E0-E7) for a step in which the trial force reached the
    threshold at its start or end. F: in, the trial force at the end of the step (spring
    after its increment, + dashpot); out, the force applied. D: out, the spring at the end.
-   (Inlined: in a flowing pile a third of the
-   contact-steps slide (in.pour's chute), nearly all through E4 at the start, whose few
-   operations cost less than a call; the general case, exact_slips, is out of line.) */
+   (Inlined: in a flowing pile a third of the contact-steps slide (in.pour's chute), nearly
+   all through E4 at the start, whose few operations cost less than a call; the general
+   case, exact_general, is out of line.) */
 __attribute__((always_inline)) inline void exact_step(const Settings &s, const Coeffs &c, double fnabs,
                                                         const double *vtr, double nu_s, double dt, double start2,
                                                         const double *F0, double *F, double *D)

@@ -82,7 +82,7 @@ CONFIGS = {  # the pair style, and the floor wall's fix arguments
 }
 LABEL = {"stock": "stock gran/hooke/history", "step": "gran/hooke/stickslip, step timing",
          "exact": "gran/hooke/stickslip, slip_timing exact"}
-PAIR_FUNCTIONS = ("PairGranHookeHistory::compute", "PairGranHookeStickSlip::", "exact_s")  # (exact_slips, exact_general)
+PAIR_FUNCTIONS = ("PairGranHookeHistory::compute", "PairGranHookeStickSlip::", "exact_slips", "exact_general")
 WALL_FUNCTIONS = ("FixWallGran::", "FixWallGranStickSlip::")  # stock's post_force and hooke_history; ours
 
 # in.pour's settings around its chute run; ${pair} and ${wall} choose the styles
