@@ -224,34 +224,48 @@ void FixWallGranStickSlip::post_force(int)
   } else if (wshear)
     vmove[axis] = vshear;
 
+  if (peratom_flag) clear_stored_contacts();
+  // the grains' loop compiled for this combination of the law's settings
+  with_fixed_mode(wall.law, [&](auto mode) { grains<decltype(mode)>(wlo, whi, vmove, stepping); });
+}
+
+/* Every grain of the group against the wall placed at wlo, whi (planes) moving at vmove.
+   The members it reads are copied into locals first, so that they stay in registers. */
+template <class Mode> void FixWallGranStickSlip::grains(double wlo, double whi, const double *vmove, bool stepping)
+{
+  constexpr int dnum = Mode::record(Settings()) ? SIZE_RECORD : SIZE_PLAIN;  // history values per grain
+  const WallLaw w = wall;
+  const int style = wallstyle, along = axis, bit = groupbit;
+  const bool spinning = wshear && axis != 2, contacts = peratom_flag;
+  const double cyl = cylradius, vsh = vshear, dt_ = dt;
+  const double *rigid = fix_rigid ? mass_rigid : nullptr;
+  double **hist = history_one, **out = array_atom;
+
   double **x = atom->x, **v = atom->v, **f = atom->f;
   double **atom_omega = atom->omega, **torque = atom->torque;
   const double *radius = atom->radius, *rmass = atom->rmass;
   const int *mask = atom->mask;
   const int nlocal = atom->nlocal;
 
-  if (peratom_flag) clear_stored_contacts();
-
   for (int i = 0; i < nlocal; i++) {
-    if (!(mask[i] & groupbit)) continue;
+    if (!(mask[i] & bit)) continue;
     // the grain centre's offset from the wall's nearest point
     double dx = 0.0, dy = 0.0, dz = 0.0;
     double vwall[3] = {vmove[0], vmove[1], vmove[2]};
-    if (wallstyle == XPLANE || wallstyle == YPLANE || wallstyle == ZPLANE) {
-      const int a = wallstyle;
-      const double below = x[i][a] - wlo, above = whi - x[i][a];
+    if (style == XPLANE || style == YPLANE || style == ZPLANE) {
+      const double below = x[i][style] - wlo, above = whi - x[i][style];
       const double d = below < above ? below : -above;
-      if (a == XPLANE)
+      if (style == XPLANE)
         dx = d;
-      else if (a == YPLANE)
+      else if (style == YPLANE)
         dy = d;
       else
         dz = d;
     } else {  // ZCYLINDER, about the z axis
       const double delxy = sqrt(x[i][0] * x[i][0] + x[i][1] * x[i][1]);
-      const double delr = cylradius - delxy;
+      const double delr = cyl - delxy;
       if (delr > radius[i])
-        dz = cylradius;  // far from the wall
+        dz = cyl;  // far from the wall
       else {
         dx = -delr / delxy * x[i][0];
         dy = -delr / delxy * x[i][1];
@@ -259,9 +273,9 @@ void FixWallGranStickSlip::post_force(int)
         // velocity at the grain, as stock's documentation says. (Stock's code adds it to a
         // translation vshear along x or y and to the wall velocity of every earlier grain
         // in contact in the step: lammps_plugin/README.md.)
-        if (wshear && axis != 2) {
-          vwall[0] = vshear * x[i][1] / delxy;
-          vwall[1] = -vshear * x[i][0] / delxy;
+        if (spinning) {
+          vwall[0] = vsh * x[i][1] / delxy;
+          vwall[1] = -vsh * x[i][0] / delxy;
           vwall[2] = 0.0;
         }
       }
@@ -269,22 +283,22 @@ void FixWallGranStickSlip::post_force(int)
     const double rsq = dx * dx + dy * dy + dz * dz;
     if (rsq > radius[i] * radius[i]) {
       // apart: the contact has ended, its history is dropped
-      for (int m = 0; m < size_history; m++) history_one[i][m] = 0.0;
+      for (int m = 0; m < dnum; m++) hist[i][m] = 0.0;
       continue;
     }
     double meff = rmass[i];
-    if (fix_rigid && mass_rigid[i] > 0.0) meff = mass_rigid[i];
+    if (rigid && rigid[i] > 0.0) meff = rigid[i];
     double *contact = nullptr;
-    if (peratom_flag) {
-      contact = array_atom[i];
+    if (contacts) {
+      contact = out[i];
       contact[0] = 1.0;
       contact[4] = x[i][0] - dx;
       contact[5] = x[i][1] - dy;
       contact[6] = x[i][2] - dz;
       contact[7] = radius[i];
     }
-    wall_contact(wall, rsq, dx, dy, dz, vwall, v[i], f[i], atom_omega[i], torque[i], radius[i], meff,
-                 history_one[i], contact, dt, stepping);
+    wall_contact<Mode>(w, rsq, dx, dy, dz, vwall, v[i], f[i], atom_omega[i], torque[i], radius[i], meff, hist[i],
+                       contact, dt_, stepping);
   }
 }
 

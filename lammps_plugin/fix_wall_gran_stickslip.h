@@ -38,6 +38,8 @@ class FixWallGranStickSlip : private WallArguments, public LAMMPS_NS::FixWallGra
 
  protected:
   WallLaw wall;
+
+  template <class Mode> void grains(double wlo, double whi, const double *vmove, bool stepping);
 };
 
 }  // namespace StickSlip

@@ -212,18 +212,14 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
     comm->forward_comm_pair(this);
   }
 
-  // the contact loop compiled for this combination of the law's settings
-  const int mode = (law.exact ? 4 : 0) + (law.project ? 2 : 0) + (law.record ? 1 : 0);
-  switch (mode) {
-    case 0: contacts<FixedMode<false, false, false>>(); break;
-    case 1: contacts<FixedMode<false, false, true>>(); break;
-    case 2: contacts<FixedMode<false, true, false>>(); break;
-    case 3: contacts<FixedMode<false, true, true>>(); break;
-    case 4: contacts<FixedMode<true, false, false>>(); break;
-    case 5: contacts<FixedMode<true, false, true>>(); break;
-    case 6: contacts<FixedMode<true, true, false>>(); break;
-    default: contacts<FixedMode<true, true, true>>(); break;
-  }
+  // the contact loop compiled for this combination of the law's settings, and for a step
+  // or a set-up evaluation (a step then tests no flag of it per contact)
+  with_fixed_mode(law, [this](auto mode) {
+    if (update->setupflag)
+      contacts<decltype(mode), false>();
+    else
+      contacts<decltype(mode), true>();
+  });
   if (vflag_fdotr) virial_fdotr_compute();
 }
 
@@ -233,10 +229,10 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
    Everything a contact reads is copied into locals first: the compiler then keeps it in
    registers across the loop (members and LAMMPS' arrays could change in any call, such as
    ev_tally_xyz, and would be loaded again for every contact). */
-template <class Mode> void PairGranHookeStickSlip::contacts()
+template <class Mode, bool STEPPING> void PairGranHookeStickSlip::contacts()
 {
   const Settings s = law;
-  const bool stepping = !update->setupflag;  // no history update (no time passes) in a set-up
+  constexpr bool stepping = STEPPING;  // false: a set-up evaluation (no time passes, no history update)
   const double kn_ = kn, gamman_ = gamman, gammat_ = gammat, dt_ = dt;
   const bool limit = limit_damping;
   const int freeze = freeze_group_bit;

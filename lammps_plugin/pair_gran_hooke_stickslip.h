@@ -36,7 +36,7 @@ class PairGranHookeStickSlip : public LAMMPS_NS::PairGranHookeHistory {
   double **mu_s_given, **mu_k_given;
   Coeffs **coeffs;
 
-  template <class Mode> void contacts();
+  template <class Mode, bool STEPPING> void contacts();
   void allocate_law();
   void pair_coefficients(int i, int j, double &mu_s, double &mu_k) const;
   double *find_history(int i, int j, double &sign) const;

@@ -147,13 +147,35 @@ inline Coeffs make_coeffs(double kt, double mu_s, double mu_k)
   return c;
 }
 
+/* exact_step's general case (E1-E7 through exact_slips). Out of line, and called on copies
+   of its vectors: an address taken on exact_step's path would keep V_s, F0 and the force in
+   memory for every contact, and the compiler would keep products it shares with the
+   sticking path (nu_s V_s) on the stack. limit = T = mu_s |Fn|, fmin = Fmin (exact_step's);
+   F: out, the force applied; D: out, the spring. */
+__attribute__((noinline)) inline void exact_general(const Settings &s, const Coeffs &c, double limit, double fmin,
+                                                    const double *vtr, double nu_s, double dt, const double *F0,
+                                                    double *F, double *D)
+{
+  const double kt = c.kt;
+  // E6 applies when nothing is added at the reset (reset total, or no dashpot)
+  const bool flow_law = c.ratio == 1.0 && (s.reset_total || nu_s == 0.0);
+  double applied[3], trial[3], stick;
+  stickslip::exact_slips(F0, vtr, limit, fmin, c.ratio, kt, nu_s, dt, s.reset_total, flow_law, applied, trial,
+                         stick);
+  // the spring at the end holds the trial force less the dashpot (eq. 5)
+  for (int k = 0; k < 3; k++) {
+    F[k] = applied[k];
+    D[k] = -(trial[k] + nu_s * vtr[k]) / kt;
+  }
+}
+
 /* Exact slip timing (docs/law.md E0-E7) for a step in which the trial force reached the
    threshold at its start or end. F: in, the trial force at the end of the step (spring
    after its increment, + dashpot); out, the force applied. D: out, the spring at the end.
-   Returns the share of the step spent sticking. (Inlined: in a flowing pile a third of the
-   contact-steps slide (in.pour's chute), nearly all through E4 at the start, whose few
-   operations cost less than a call; the general case, exact_slips, is out of line.) */
-__attribute__((always_inline)) inline double exact_step(const Settings &s, const Coeffs &c, double fnabs,
+   (Inlined: in a flowing pile a third of the contact-steps slide (in.pour's chute), nearly
+   all through E4 at the start, whose few operations cost less than a call; the general
+   case, exact_general, is out of line.) */
+__attribute__((always_inline)) inline void exact_step(const Settings &s, const Coeffs &c, double fnabs,
                                                         const double *vtr, double nu_s, double dt, double start2,
                                                         const double *F0, double *F, double *D)
 {
@@ -173,25 +195,22 @@ __attribute__((always_inline)) inline double exact_step(const Settings &s, const
       F[k] = -a * vtr[k];
       D[k] = akt * vtr[k];
     }
-    return 0.0;
+    return;
   }
-  // E6 applies when nothing is added at the reset (reset total, or no dashpot)
-  const bool flow_law = c.ratio == 1.0 && (s.reset_total || nu_s == 0.0);
-  double applied[3], trial[3], stick;
-  stickslip::exact_slips(F0, vtr, limit, fmin, c.ratio, kt, nu_s, dt, s.reset_total, flow_law, applied, trial,
-                         stick);
-  // the spring at the end holds the trial force less the dashpot (eq. 5)
+  // the general case: on copies (exact_general)
+  const double v[3] = {vtr[0], vtr[1], vtr[2]}, f0[3] = {F0[0], F0[1], F0[2]};
+  double f[3], d[3];
+  exact_general(s, c, limit, fmin, v, nu_s, dt, f0, f, d);
   for (int k = 0; k < 3; k++) {
-    F[k] = applied[k];
-    D[k] = -(trial[k] + nu_s * vtr[k]) / kt;
+    F[k] = f[k];
+    D[k] = d[k];
   }
-  return stick;
 }
 
 /* Which of the law's branches the tangential force tests at run time. RuntimeMode reads the
-   settings (the walls); FixedMode<EXACT, PROJECT, RECORD> fixes the three that shape the
-   contact's code (the pair style compiles its contact loop once per combination, so that a
-   contact-step carries no test of them). */
+   settings (the region wall); FixedMode<EXACT, PROJECT, RECORD> fixes the three that shape
+   the contact's code (the pair style and the primitive walls compile their contact loop once
+   per combination, so that a contact-step carries no test of them). */
 struct RuntimeMode {
   static bool exact(const Settings &s) { return s.exact; }
   static bool project(const Settings &s) { return s.project; }
@@ -203,6 +222,23 @@ template <bool EXACT, bool PROJECT, bool RECORD> struct FixedMode {
   static constexpr bool project(const Settings &) { return PROJECT; }
   static constexpr bool record(const Settings &) { return RECORD; }
 };
+
+/* Calls loop(FixedMode<...>()) with the mode of the settings s: the one place that turns
+   the run-time settings into a compiled loop (the caller's generic lambda instantiates its
+   loop once per mode). */
+template <class Loop> inline void with_fixed_mode(const Settings &s, Loop &&loop)
+{
+  switch ((s.exact ? 4 : 0) + (s.project ? 2 : 0) + (s.record ? 1 : 0)) {
+    case 0: loop(FixedMode<false, false, false>()); break;
+    case 1: loop(FixedMode<false, false, true>()); break;
+    case 2: loop(FixedMode<false, true, false>()); break;
+    case 3: loop(FixedMode<false, true, true>()); break;
+    case 4: loop(FixedMode<true, false, false>()); break;
+    case 5: loop(FixedMode<true, false, true>()); break;
+    case 6: loop(FixedMode<true, true, false>()); break;
+    default: loop(FixedMode<true, true, true>()); break;
+  }
+}
 
 /* The tangential law at one contact for one force evaluation (docs/law.md steps 3-5).
    del: x_i - x_j (for a wall, the body's offset from the wall), rsqinv = 1/|del|^2;
@@ -258,6 +294,14 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
       for (int k = 0; k < 3; k++) D[k] *= scale;
     }
     for (int k = 0; k < 3; k++) D[k] += vtr[k] * dt;  // eq. 7
+  }
+  // the spring is stored now (without record, which reads the old one below): a sticking step
+  // leaves it so, and it need not stay in registers through the slip test; a slip stores
+  // the reset spring at the end
+  if (!Mode::record(s)) {
+    hist[0] = D[0];
+    hist[1] = D[1];
+    hist[2] = D[2];
   }
 
   // eq. 5: trial force = spring + dashpot
@@ -321,9 +365,11 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
     hist[HIST_FN] = ccel_r;
     for (int k = 0; k < 3; k++) hist[HIST_FS + k] = fs[k];
   }
-  hist[0] = D[0];
-  hist[1] = D[1];
-  hist[2] = D[2];
+  if (Mode::record(s) || slipped) {
+    hist[0] = D[0];
+    hist[1] = D[1];
+    hist[2] = D[2];
+  }
 }
 
 /* The lever arm from a body's centre to the contact: its radius (stock), or with

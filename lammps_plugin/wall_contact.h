@@ -26,8 +26,10 @@ struct WallLaw {
    the grain's; f, torque: its force and torque, added to; radius; meff: its mass (or its
    rigid body's); hist: the contact's history (size w.law.history_size()); contact: stock's
    per-atom output row (null: none): columns 1-3 the total force, and with record 8-13 the
-   record (Fn, Fs, slip count, work); dt, update: the step, and whether time passes. */
-inline void wall_contact(const WallLaw &w, double rsq, double dx, double dy, double dz, const double *vwall,
+   record (Fn, Fs, slip count, work); dt, update: the step, and whether time passes.
+   Mode: RuntimeMode, or the FixedMode of a loop compiled for the settings (stick_slip_law.h). */
+template <class Mode = RuntimeMode>
+__attribute__((always_inline)) inline void wall_contact(const WallLaw &w, double rsq, double dx, double dy, double dz, const double *vwall,
                          const double *v, double *f, const double *omega, double *torque, double radius, double meff,
                          double *hist, double *contact, double dt, bool update)
 {
@@ -55,7 +57,7 @@ inline void wall_contact(const WallLaw &w, double rsq, double dx, double dy, dou
   const double vtr[3] = {vt1 - (dz * wr2 - dy * wr3), vt2 - (dx * wr3 - dz * wr1), vt3 - (dy * wr1 - dx * wr2)};
   const double del[3] = {dx, dy, dz};
   double fs[3];
-  tangential_force(w.law, w.coeffs, del, rsqinv, ccel * r, vtr, m * w.gammat, dt, update, hist, fs);
+  tangential_force<Mode>(w.law, w.coeffs, del, rsqinv, ccel * r, vtr, m * w.gammat, dt, update, hist, fs);
 
   // forces and torques
   const double fx = dx * ccel + fs[0], fy = dy * ccel + fs[1], fz = dz * ccel + fs[2];
@@ -66,7 +68,7 @@ inline void wall_contact(const WallLaw &w, double rsq, double dx, double dy, dou
     contact[1] = fx;
     contact[2] = fy;
     contact[3] = fz;
-    if (w.law.record)
+    if (Mode::record(w.law))
       for (int k = 0; k < 6; k++) contact[8 + k] = hist[HIST_FN + k];
   }
   const double tor1 = rinv * (dy * fs[2] - dz * fs[1]);

@@ -142,3 +142,59 @@ def instruction_counts(profile, want):
             if fn is not None and len(fields) >= 3 and want(fn):
                 runs[fn][address] += int(fields[2])
     return runs
+
+
+_FILE = re.compile(r"(c?fl|c?fi|fe)=\((\d+)\)(?: (.*))?")
+
+
+def instruction_lines(profile, want):
+    """{address: (function, source file, line, times run)} for the instructions whose source file
+    `want` accepts, from a profile written with --dump-instr=yes --dump-line=yes of a
+    program built with debug information (each cost line: address, line, instructions).
+    The file is the function's (fl=), or that of code inlined into it (fi=, fe=, until the
+    next fn=); a call's file (cfi=, cfl=) names the callee and changes nothing here, but may
+    be where a file's name is written (all share one table of names)."""
+    files, functions, runs = {}, {}, {}
+    fn_file = file = fn = None
+    address = line_no = 0
+    call_cost_follows = False
+
+    def step(value, text):
+        # positions are compressed: +n / -n relative to the previous one, * the same
+        return (value + int(text[1:], 0) if text[0] == "+" else value - int(text[1:], 0) if text[0] == "-"
+                else value if text == "*" else int(text, 0))
+
+    with open(profile) as f:
+        for raw in f:
+            m = _FILE.match(raw)
+            if m:
+                if m.group(3):
+                    files[m.group(2)] = m.group(3)
+                if m.group(1).startswith("c"):
+                    continue
+                file = files.get(m.group(2), m.group(2))
+                if m.group(1) == "fl":
+                    fn_file = file
+                continue
+            if raw.startswith(("fn=", "cfn=")):  # (a name may first be written at a call)
+                ident, _, name = raw[raw.index("(") + 1:].rstrip("\n").partition(")")
+                if name.strip():
+                    functions[ident] = name.strip()
+                if raw.startswith("fn="):
+                    fn, file = functions.get(ident, ident), fn_file
+                continue
+            if raw.startswith("calls="):
+                call_cost_follows = True
+                continue
+            if raw[:1] not in "0123456789+-*":
+                continue
+            fields = raw.split()
+            address = step(address, fields[0])
+            line_no = step(line_no, fields[1])
+            if call_cost_follows:  # a call's inclusive cost: not this instruction's runs
+                call_cost_follows = False
+                continue
+            if len(fields) >= 3 and file is not None and want(file):
+                old = runs.get(address, (fn, file, line_no, 0))
+                runs[address] = (fn, file, line_no, old[3] + int(fields[2]))
+    return runs

@@ -26,9 +26,10 @@ engine's geometry shared by both styles.
    the quiet rounds when there are at least 3 (a busy second core slows a run through the
    shared caches even when the run keeps its core).
 2. Overhead, counted: callgrind's instructions over CALLGRIND_STEPS steps after the same
-   warm-up (not instrumented), in the whole time step (LAMMPS' Verlet::run) and in the pair
-   style's own functions; the same binaries and input give the same counts whatever the
-   machine's load.
+   warm-up (not instrumented), in the whole time step (LAMMPS' Verlet::run), in the pair
+   style's own functions and in the wall's; the same binaries and input give the same
+   counts whatever the machine's load. (The exact timing's out-of-line functions are
+   counted with the pair style: the wall calls them too, for its few contacts.)
 3. MPI: the step configuration on 1 and on 2 processes (`mpirun -np 2`), LAMMPS' "Loop
    time" of the timed steps, medians of `reps` runs each alternating 1, 2, 2, 1, ...;
    speed-up = T1 / T2.
@@ -36,7 +37,7 @@ engine's geometry shared by both styles.
 Cost on the 2-core machine, idle: ~15 s once for the pour; ~4 s a round (10 by default);
 ~1 min of callgrind (two at a time); ~5 s per MPI repetition.
 
-    python -m stickslip.adapters.lammps_bench [--rounds 10] [--reps 3] [--no-callgrind]
+    python -m stickslip.adapters.lammps_bench [--rounds 10] [--reps 3] [--no-callgrind] [--callgrind-steps 200]
 """
 from __future__ import annotations
 
@@ -82,7 +83,8 @@ CONFIGS = {  # the pair style, and the floor wall's fix arguments
 }
 LABEL = {"stock": "stock gran/hooke/history", "step": "gran/hooke/stickslip, step timing",
          "exact": "gran/hooke/stickslip, slip_timing exact"}
-PAIR_FUNCTIONS = ("PairGranHookeHistory::compute", "PairGranHookeStickSlip::", "exact_s")
+PAIR_FUNCTIONS = ("PairGranHookeHistory::compute", "PairGranHookeStickSlip::", "exact_slips", "exact_general")
+WALL_FUNCTIONS = ("FixWallGran::", "FixWallGranStickSlip::")  # stock's post_force and hooke_history; ours
 
 # in.pour's settings around its chute run; ${pair} and ${wall} choose the styles
 TIMED = """\
@@ -238,14 +240,17 @@ def _contacts(out, step):
     return float(rows[-1][2]) / 2
 
 
-def _counted(data, config, work):
-    """callgrind: instructions in the whole time step and in the pair style, CALLGRIND_STEPS steps."""
+def _counted(data, config, work, steps=CALLGRIND_STEPS):
+    """callgrind: instructions in the whole time step, in the pair style and in the wall, over
+    `steps` steps."""
     d = _folder(work, f"callgrind-{config}")
-    (d / "in.timed").write_text(_script(data, CALLGRIND_STEPS, "shell ./callgrind_on.sh"))
+    (d / "in.timed").write_text(_script(data, steps, "shell ./callgrind_on.sh"))
     profiles = callgrind.count(_command(config), d, env=_env(), on_request=True)
     profile = profiles[-1]
-    pair = sum(v for fn, v in callgrind.self_costs(profile).items() if any(p in fn for p in PAIR_FUNCTIONS))
-    return {"total": callgrind.total(profile), "pair": pair}
+    costs = callgrind.self_costs(profile)
+    pair = sum(v for fn, v in costs.items() if any(p in fn for p in PAIR_FUNCTIONS))
+    wall = sum(v for fn, v in costs.items() if any(p in fn for p in WALL_FUNCTIONS))
+    return {"total": callgrind.total(profile), "pair": pair, "wall": wall, "steps": steps}
 
 
 def _mpi(data, nproc, work):
@@ -259,7 +264,7 @@ def _mpi(data, nproc, work):
             "cpu_use": float(CPU_USE.findall(out)[-1])}
 
 
-def measure(rounds=ROUNDS, reps=3, counts=True):
+def measure(rounds=ROUNDS, reps=3, counts=True, callgrind_steps=CALLGRIND_STEPS):
     """Every figure of the benchmark (a dict; rows() turns it into bench rows)."""
     _check()
     data = _pour()
@@ -271,7 +276,7 @@ def measure(rounds=ROUNDS, reps=3, counts=True):
             res["rounds"].append({c: _timed(data, c, work) for c in turn})
         if counts and callgrind.available():
             with concurrent.futures.ThreadPoolExecutor(2) as pool:
-                jobs = {c: pool.submit(_counted, data, c, work) for c in order}
+                jobs = {c: pool.submit(_counted, data, c, work, callgrind_steps) for c in order}
                 res["counts"] = {c: j.result() for c, j in jobs.items()}
         for k in range(reps):
             for nproc in ((1, 2) if k % 2 == 0 else (2, 1)):
@@ -301,15 +306,19 @@ def rows(res):
                     "value": ratio})
     counts = res["counts"]
     if counts:
+        n = counts["stock"]["steps"]
         for c in CONFIGS:
-            out.append({"benchmark": "lammps", "case": f"{LABEL[c]}: instructions per step, whole step / pair style "
-                                                      f"(callgrind, {CALLGRIND_STEPS} steps)",
-                        "value": f"{counts[c]['total'] / CALLGRIND_STEPS:.4g} / {counts[c]['pair'] / CALLGRIND_STEPS:.4g}"})
+            k = counts[c]
+            out.append({"benchmark": "lammps", "case": f"{LABEL[c]}: instructions per step, whole step / pair style / "
+                                                      f"wall (callgrind, {n} steps)",
+                        "value": f"{k['total'] / n:.4g} / {k['pair'] / n:.4g} / {k['wall'] / n:.4g}"})
+        s = counts["stock"]
         for c in ("step", "exact"):
-            out.append({"benchmark": "lammps", "case": f"{LABEL[c]} / stock, instructions: whole step / pair style "
-                                                      f"(target <= {TARGET[c]})",
-                        "value": f"{counts[c]['total'] / counts['stock']['total']:.4f} / "
-                                 f"{counts[c]['pair'] / counts['stock']['pair']:.4f}"})
+            k = counts[c]
+            out.append({"benchmark": "lammps", "case": f"{LABEL[c]} / stock, instructions: whole step / pair style / "
+                                                      f"pair style + wall (target <= {TARGET[c]})",
+                        "value": f"{k['total'] / s['total']:.4f} / {k['pair'] / s['pair']:.4f} / "
+                                 f"{(k['pair'] + k['wall']) / (s['pair'] + s['wall']):.4f}"})
     t1 = statistics.median(x["loop"] for x in res["mpi"][1])
     t2 = statistics.median(x["loop"] for x in res["mpi"][2])
     n = len(res["mpi"][1])
@@ -338,9 +347,12 @@ def main(argv=None):
     ap.add_argument("--rounds", type=int, default=ROUNDS)
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--no-callgrind", action="store_true")
+    ap.add_argument("--callgrind-steps", type=int, default=CALLGRIND_STEPS, help="steps counted by callgrind")
     a = ap.parse_args(argv)
+    if a.callgrind_steps < 1:
+        ap.error("--callgrind-steps must be >= 1")
     try:
-        res = measure(a.rounds, a.reps, counts=not a.no_callgrind)
+        res = measure(a.rounds, a.reps, counts=not a.no_callgrind, callgrind_steps=a.callgrind_steps)
     except RuntimeError as e:
         print(f"lammps_bench: {e}", file=sys.stderr)
         return 1
