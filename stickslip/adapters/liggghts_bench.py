@@ -150,6 +150,8 @@ while [ "$p" -gt 1 ]; do
       read -r s < /proc/$p/schedstat; read -r u < /proc/uptime; read -r c < /proc/stat
       echo "$s | $u | $c" >> probe.log
       read -r go < go.fifo
+      read -r s < /proc/$p/schedstat; read -r u < /proc/uptime; read -r c < /proc/stat
+      echo "$s | $u | $c" >> probe.log
       exit 0;;
   esac
   set -- ${line##*) }
@@ -347,8 +349,11 @@ def _probe_chunks(log):
         ticks = [int(x) for x in cpu.split()[1:]]
         busy = sum(ticks) - ticks[3] - (ticks[4] if len(ticks) > 4 else 0)  # all but idle and iowait
         marks.append((run_ns * 1e-9, wait_ns * 1e-9, float(up.split()[0]), busy / tick))
+    # each probe writes a mark when the run reaches it and another when it is let go: a
+    # chunk runs from one probe's second mark to the next probe's first (the time the run
+    # waited at a probe, while the other configurations ran, is not the chunk's)
     chunks = []
-    for a, b in zip(marks, marks[1:]):
+    for a, b in zip(marks[1::2], marks[2::2]):
         own, wall = b[0] - a[0], b[2] - a[2]
         # uptime and /proc/stat count in 1/100 s: a 0.5 s chunk reads other processes' CPU to ~0.04 cores
         foreign = max(0.0, (b[3] - a[3] - own) / wall) if wall > 0 else math.inf
@@ -379,7 +384,7 @@ class _Paused:
         """Until the run has reached its next probe (and stopped there)."""
         t0 = time.monotonic()
         log = self.d / "probe.log"
-        while not (log.is_file() and len(log.read_text().splitlines()) > self.probes):
+        while not (log.is_file() and len(log.read_text().splitlines()) > 2 * self.probes):
             if self.p.poll() is not None:
                 self._fail()
             if time.monotonic() - t0 > timeout:
