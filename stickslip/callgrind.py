@@ -84,6 +84,13 @@ def total(profile):
 _NAME = re.compile(r"(c?fn)=\((\d+)\)(?: (.*))?")
 
 
+def _position(previous, text):
+    """A cost line's address or line number: profiles compress them as +n / -n relative to
+    the previous one, * the same, or write them in full."""
+    return (previous + int(text[1:], 0) if text[0] == "+" else previous - int(text[1:], 0) if text[0] == "-"
+            else previous if text == "*" else int(text, 0))
+
+
 def self_costs(profile):
     """Instructions per function in a profile, each function's own (what it calls excluded)."""
     names, costs = {}, collections.Counter()
@@ -132,10 +139,7 @@ def instruction_counts(profile, want):
             if line[:1] not in "0123456789+-*":
                 continue
             fields = line.split()
-            # positions are compressed: +n / -n relative to the previous address, * the same
-            a = fields[0]
-            address = address + int(a[1:], 0) if a[0] == "+" else address - int(a[1:], 0) if a[0] == "-" \
-                else address if a == "*" else int(a, 0)
+            address = _position(address, fields[0])
             if call_cost_follows:  # a call's inclusive cost, at the call's address: not this instruction's runs
                 call_cost_follows = False
                 continue
@@ -158,11 +162,6 @@ def instruction_lines(profile, want):
     fn_file = file = fn = None
     address = line_no = 0
     call_cost_follows = False
-
-    def step(value, text):
-        # positions are compressed: +n / -n relative to the previous one, * the same
-        return (value + int(text[1:], 0) if text[0] == "+" else value - int(text[1:], 0) if text[0] == "-"
-                else value if text == "*" else int(text, 0))
 
     with open(profile) as f:
         for raw in f:
@@ -189,8 +188,8 @@ def instruction_lines(profile, want):
             if raw[:1] not in "0123456789+-*":
                 continue
             fields = raw.split()
-            address = step(address, fields[0])
-            line_no = step(line_no, fields[1])
+            address = _position(address, fields[0])
+            line_no = _position(line_no, fields[1])
             if call_cost_follows:  # a call's inclusive cost: not this instruction's runs
                 call_cost_follows = False
                 continue
