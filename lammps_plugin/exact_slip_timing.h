@@ -32,7 +32,7 @@ inline void plastic_flow(double *F, const double *u, double k_rest, double T)
   double q[3];
   for (int k = 0; k < 3; k++) q[k] = F[k] - f * u[k];
   const double qn = std::sqrt(dot3(q, q));
-  const double s = qn / (T + f) * std::exp(-k_rest);  // tan(phi/2) at the end (f > 0 here)
+  const double s = qn / (T + f) * std::exp(-k_rest);  // tan(phi/2) at the end (f >= 0 here)
   const double c = (1.0 - s * s) / (1.0 + s * s), sn = 2.0 * s / (1.0 + s * s);
   for (int k = 0; k < 3; k++) F[k] = (T * c) * u[k] + (T * sn) * (qn > 0.0 ? q[k] / qn : 0.0);
 }
@@ -113,7 +113,9 @@ __attribute__((noinline)) inline void exact_slips(const double *F0, const double
       return;
     }
     const double along = dot3(t, u);
-    if (flow_law && along > 0.0) {  // E6: plastic flow on |F| = T
+    // (t.u = 0 too: |F + rate theta u| = T sqrt(1 + (rate theta/T)^2) rises at once, so the
+    // force flows from phi = 90 degrees; only t.u < 0 unloads into the cone and sticks)
+    if (flow_law && along >= 0.0) {  // E6: plastic flow on |F| = T
       plastic_flow(F, u, rate * rest / T, T);
       for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
       return;

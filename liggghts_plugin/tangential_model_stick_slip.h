@@ -95,7 +95,7 @@ namespace StickSlip {
     double q[3];
     for (int k = 0; k < 3; k++) q[k] = F[k] - f * u[k];
     const double qn = std::sqrt(dot(q, q));
-    const double s = qn / (T + f) * std::exp(-k_rest);  // tan(phi/2) at the end (f > 0 here)
+    const double s = qn / (T + f) * std::exp(-k_rest);  // tan(phi/2) at the end (f >= 0 here)
     const double c = (1.0 - s * s) / (1.0 + s * s), sn = 2.0 * s / (1.0 + s * s);
     for (int k = 0; k < 3; k++) F[k] = (T * c) * u[k] + (T * sn) * (qn > 0.0 ? q[k] / qn : 0.0);
   }
@@ -170,7 +170,9 @@ namespace StickSlip {
         return;
       }
       const double along = dot(t, u);
-      if (flow_law && along > 0.0) {  // E6: plastic flow on |F| = T
+      // (t.u = 0 too: |F + rate theta u| = T sqrt(1 + (rate theta/T)^2) rises at once, so the
+      // force flows from phi = 90 degrees; only t.u < 0 unloads into the cone and sticks)
+      if (flow_law && along >= 0.0) {  // E6: plastic flow on |F| = T
         STICK_SLIP_COUNT(GEN_E6);
         plastic_flow(F, u, rate * rest / T, T);
         for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
@@ -201,6 +203,9 @@ namespace StickSlip {
   }
 }
 
+#ifdef STICK_SLIP_CONTROL_STOCK
+#include "control_stock_history.h"  // the benchmark's control (issue 32), not the law
+#else
 template<>
 class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
 {
@@ -591,6 +596,7 @@ public:
   }
   inline void endPass(SurfacesIntersectData &, ForceData &, ForceData &) {}
 };
+#endif  // STICK_SLIP_CONTROL_STOCK
 
 }
 }

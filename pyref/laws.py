@@ -273,7 +273,9 @@ def _exact_slips(D0, V_s, fn, dt, p, mu_s, mu_k):
         frozen = ~slide & (rate[h] == 0)
         # E6. mu_k = mu_s and nothing added at the reset: plastic flow on |F| = T.
         along = _dot(t, u[h])
-        flow = (~slide & ~frozen & (along > 0)) if flow_law else np.zeros(len(h), bool)
+        # (t.u = 0 too: |F + rate theta u| = T sqrt(1 + (rate theta/T)^2) rises at once: it
+        # flows from phi = 90 degrees; only t.u < 0 unloads into the cone and sticks again)
+        flow = (~slide & ~frozen & (along >= 0)) if flow_law else np.zeros(len(h), bool)
         if _any(slide):
             i = h[slide]
             finish(i, (f_min[i] + kept[i])[:, None] * u[i], f_min[i, None] * u[i], 0.0)
@@ -325,7 +327,7 @@ def _plastic_flow(F, u, k_rest, T):
     f = _dot(F, u)
     q = F - f[:, None] * u
     qn = np.sqrt(_dot(q, q))
-    s = qn / (T + f) * np.exp(-k_rest)  # tan(phi/2) at the end (f > 0 here)
+    s = qn / (T + f) * np.exp(-k_rest)  # tan(phi/2) at the end (f >= 0 here)
     cos, sin = (1.0 - s * s) / (1.0 + s * s), 2.0 * s / (1.0 + s * s)
     p_hat = np.divide(q, qn[:, None], out=np.zeros_like(q), where=qn[:, None] > 0)
     return (T * cos)[:, None] * u + (T * sin)[:, None] * p_hat

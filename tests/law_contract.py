@@ -53,11 +53,13 @@ class Segment:
 class Expect:
     """What the contact holds at the end of a step: Fn, the force on i and the spring as
     multiples of w (F = -f*w, D = d*w; vectors directly when given as tuples), and the
-    number of steps that slipped since the contact began."""
+    number of steps that slipped since the contact began. `tol`: an absolute bound for this
+    step, derived where it is set, instead of the case's ulps."""
     fn: float
     f: float | tuple
     d: float | tuple
     slips: int
+    tol: float | None = None
 
 
 @dataclass(frozen=True)
@@ -168,6 +170,11 @@ def _cases():
     # Every later step starts at 16, slips at 1/8 and ends the same way: 16.
     cases.append(Case("several_slips_in_a_step_exact_timing", "E7: the rest of the step in whole cycles",
                       "wall", (Segment(4, (8.0, 0.0, 0.0)),), 20 * X, 16 * X, timing="exact"))
+    # The same at 64 w a step (rate = Ks |V| dt = 1 exactly, a value no other test has):
+    # step 1 meets T at 20/64 = 5/16, then cycles of 8/64 = 1/8: five whole and 1/16 left,
+    # 12 + 4 = 16; every later step starts at 16, slips at 1/16 and ends at 16 again.
+    cases.append(Case("several_slips_in_a_step_rate_one_exact_timing", "E7: the rest of the step in whole cycles",
+                      "wall", (Segment(4, (16.0, 0.0, 0.0)),), 20 * X, 16 * X, timing="exact"))
     # Exact timing with mu_k = mu_s and no dashpot (E6, plastic flow): 24 steps along +x
     # load the spring to T (the 24th slips at its very end, with no time left), then the
     # grain slides along (3, 4)/5: the force stays on |F| = T and turns towards u = -V/|V|,
@@ -175,6 +182,36 @@ def _cases():
     cases.append(Case("plastic_flow_exact_timing", "E6: mu_k = mu_s, the force turns on |F| = T",
                       "wall", (Segment(24, ALONG_X), Segment(1, DIAGONAL)), 24 * X, 24 * X, timing="exact",
                       ulps=16, why_ulps="an exponential and a dozen roundings on the turned force's path"))
+    # The same turn from a force at T across u (t.u = 0 exactly: loaded along x, then sliding
+    # along y): |F + rate theta u| rises above T at once, so it flows from phi = 90 degrees
+    # (E6 with t.u >= 0), tan(phi/2) from 1 to exp(-rate/T).
+    cases.append(Case("plastic_flow_across_exact_timing", "E6 at t.u = 0: the force flows from 90 degrees",
+                      "wall", (Segment(24, ALONG_X), Segment(1, (0.0, 0.25, 0.0))), 24 * X, 24 * X, timing="exact",
+                      ulps=16, why_ulps="an exponential and a dozen roundings on the turned force's path"))
+    # E6 with a dashpot and reset total (kept = 0), the slip inside the step: nu_s V = 4 w
+    # (nu_s = 1/4), the trial force k + 4 meets T = 24 at the end of step 20 (slips, F = T
+    # along -x, spring 20); then the diagonal step meets T at theta = 0.71 and flows for the
+    # rest (see _flow_after_hit).
+    cases.append(Case("plastic_flow_reset_total_inside_step_exact_timing",
+                      "E6 with reset total and a dashpot; the flow over the rest of the step after a slip inside it",
+                      "wall", (Segment(20, ALONG_X), Segment(1, DIAGONAL)), 24 * X, 24 * X, nu_s=0.25, reset="total",
+                      timing="exact", ulps=32,
+                      why_ulps="a square root with cancellation (the slip's theta, 20 eps relative), an exponential "
+                               "and a dozen roundings on the turned force's path"))
+    # E7 after MAX_EXPLICIT_SLIPS slips with a part q across u (docs/law.md E7: the rest of
+    # the step in closed form, q shrinking by r a slip). mu_s = 1/2, Fmin = 15/32 (r = 15/16,
+    # q not settled after 100 slips: (15/16)^100 q0 = 4e-4 > 1e-8 T): the spring loaded along
+    # x to 1/4 (16 steps), then one step along y at rate = Ks |V| dt = 4, ~110 slips in it.
+    # Without dashpot the rest is periodic with r^n q (see _max_slips_step); with a dashpot
+    # that restarts each slip at exactly T along u (kept = nu_s |V| = T - Fmin = 1/32) the
+    # force after each slip stays below T while t != u (|F|^2 = T^2 - 2 Fmin kept (1 - t.u)),
+    # so no E4: after 100 slips L = (T - Fmin - kept)/rate = 0 and the contact slides (E7).
+    for label, nu_s in (("periodic", 0.0), ("slides", 1.0 / 2048)):
+        cases.append(Case(f"max_explicit_slips_{label}_exact_timing",
+                          "E7 after MAX_EXPLICIT_SLIPS slips, q not settled: " +
+                          ("r^n q in closed form" if nu_s == 0 else "L = 0: slides at Fmin"),
+                          "wall", (Segment(16, ALONG_X), Segment(1, (0.0, 64.0, 0.0))), 0.5, 31.0 / 64,
+                          nu_s=nu_s, timing="exact"))
     # Exact timing, the dashpot's sliding regime (E4): nu_s V = 16 w with T = 24, Fmin = 12
     # (reset spring): the trial force k + 16 reaches T at the end of step 8; restarted at
     # Fmin + kept = 28 >= T it slides: applied Fmin = 12 along -V, spring 28 - 16 = 12, and
@@ -251,6 +288,20 @@ def expected(case: Case):
         return [Expect(1.0, k, k, 0) for k in range(1, 19)] + still
     if name == "several_slips_in_a_step_exact_timing":
         return [Expect(1.0, 0.5, 0.5, k) for k in range(1, n + 1)]  # 16 X = w/2 (w = 32 X)
+    if name == "several_slips_in_a_step_rate_one_exact_timing":
+        return [Expect(1.0, 0.25, 0.25, k) for k in range(1, n + 1)]  # 16 X = w/4 (w = 64 X)
+    if name == "plastic_flow_across_exact_timing":
+        # F = -T x at T, u = -y: phi = 90 degrees, tan(phi/2) = 1, the part across u along -x
+        T = 24 * X
+        F = _flow(T, (0.0, -1.0, 0.0), (-1.0, 0.0, 0.0), 1.0, X / T)
+        return [Expect(1.0, k, k, 0) for k in range(1, 24)] + [Expect(1.0, 24, 24, 1),
+                                                                Expect(1.0, tuple(-F), tuple(-F), 2)]
+    if name == "plastic_flow_reset_total_inside_step_exact_timing":
+        loading = [Expect(1.0, k + 4, k, 0) for k in range(1, 20)] + [Expect(1.0, 24, 20, 1)]
+        return loading + [_flow_after_hit()]
+    if name.startswith("max_explicit_slips"):
+        dashpot = case.nu_s * ALONG_X[0] / X  # nu_s V along x, in units of w (exact: 1/128)
+        return [Expect(1.0, k + dashpot, k, 0) for k in range(1, 17)] + [_max_slips_step(case)]
     if name == "plastic_flow_exact_timing":
         return [Expect(1.0, k, k, 0) for k in range(1, 24)] + [Expect(1.0, 24, 24, 1), _plastic_flow_step()]
     if name == "slip_at_step_start_exact_timing":
@@ -279,6 +330,78 @@ def _plastic_flow_step():
     u, p = np.array([-0.6, -0.8, 0.0]), np.array([-0.8, 0.6, 0.0])
     F = T * ((1 - s * s) * u + 2 * s * p) / (1 + s * s)
     return Expect(1.0, tuple(-F), tuple(-F), 2)
+
+
+def _flow(T, u, p, tan_half, k_rest):
+    """E6's closed form: the force on |F| = T at angle phi from u (tan(phi/2) = tan_half, the
+    part across u along p) after the rest of a step with rate*rest/T = k_rest."""
+    s = tan_half * math.exp(-k_rest)
+    return T * ((1 - s * s) * np.array(u) + 2 * s * np.array(p)) / (1 + s * s)
+
+
+def _flow_after_hit():
+    """plastic_flow_reset_total_inside_step, the diagonal step, by hand in units of X = 1/64:
+    the spring holds 20 along x; the trial force starts at F0 = -(20 + 3, 4, 0) (the dashpot
+    nu_s V = (3, 4, 0)), u = -(3, 4, 0)/5, rate = Ks |V| dt = 5/4. Along u: f = F0.u = 17,
+    across: q = F0 - f u = (-12.8, 9.6, 0), |q| = 16. |F| meets T = 24 where f + rate theta =
+    sqrt(24^2 - 16^2) = sqrt(320): theta = (sqrt(320) - 17)/(5/4). There it slips to T t
+    (r = 1, kept = 0) and flows for 1 - theta: tan(phi/2) = |q|/(T + sqrt(320)) falls by
+    exp(-rate (1 - theta)/T). Spring at the end: D = -(F + nu_s V)/Ks (reset total holds
+    spring + dashpot = Fmin, the force being applied)."""
+    T, rate, f, qn = 24.0, 5.0 / 4, 17.0, 16.0
+    u, p = np.array([-0.6, -0.8, 0.0]), np.array([-0.8, 0.6, 0.0])
+    a_hit = math.sqrt(T * T - qn * qn)
+    theta = (a_hit - f) / rate
+    F = _flow(T, u, p, qn / (T + a_hit), rate * (1 - theta) / T) * X
+    D = -(F + 0.25 * np.array(DIAGONAL)) / KS
+    return Expect(1.0, tuple(-F), tuple(D), 2)
+
+
+def max_slips_follow(case):
+    """The diagonal-free 2D picture of max_explicit_slips_*'s sliding step, followed by hand
+    from docs/law.md: a = F.u along u = -y, q across it (along -x), the force loading along u
+    at `rate` per unit theta. A slip happens where a^2 + q^2 = T^2 (E2), a = sqrt(T^2 - q^2);
+    it restarts the force at Fmin t + kept u (E3): a <- r a + kept, q <- r q. After
+    MAX_EXPLICIT_SLIPS slips the rest, 1 - theta, is E7's: with low = Fmin + kept and L =
+    (T - low)/rate, n = floor(rest/L) whole cycles and `part` left (L = 0: slides).
+    Returns (theta of the last followed slip, a and q after it, rest, L)."""
+    from pyref.laws import MAX_EXPLICIT_SLIPS
+    T, fmin = case.mu_s, 2 * case.mu_k - case.mu_s
+    r, V = fmin / T, case.segments[1].velocity[1]
+    rate, kept = KS * V * DT, case.nu_s * V
+    a, q = case.nu_s * V, 16 * X * KS  # F0 = -(Ks D + nu_s V): D = 16 X along x, the dashpot along y
+    theta = 0.0
+    for _ in range(MAX_EXPLICIT_SLIPS):
+        hit = math.sqrt(T * T - q * q)
+        assert hit > a  # below T after every slip (no E4), worked out in the case's comment
+        theta += (hit - a) / rate
+        a, q = r * hit + kept, r * q
+        assert (r * hit + kept) ** 2 + q * q < T * T  # (E4 would slide at once)
+    assert theta < 1 and q > 1e-8 * T  # all 100 inside the step, q not settled (E7's other way in)
+    return theta, a, q, 1.0 - theta, (T - fmin - kept) / rate
+
+
+def _max_slips_step(case):
+    """max_explicit_slips_*: the force at the end of the sliding step (units: absolute).
+    Slides (L = 0): Fmin u applied, trial (Fmin + kept) u, spring -(trial + nu_s V)/Ks =
+    Fmin along +y, all exact in binary. Periodic: trial = (Fmin + rate part) u + r^n q, with
+    q along -x. Its tolerance: each followed slip rounds its theta (a square root of
+    T^2 - q^2 formed with cancellation, a division, a sum: <= 8 eps (T + rate) in rate*theta),
+    so over 100 slips the force along u may be off by 100 * 8 eps (T + rate); the values of
+    the mutants this row is for differ by >1e-7 (closed form after 50 slips, or none)."""
+    T, fmin = case.mu_s, 2 * case.mu_k - case.mu_s
+    V = case.segments[1].velocity[1]
+    rate, u = KS * V * DT, np.array([0.0, -1.0, 0.0])
+    theta, a, q, rest, L = max_slips_follow(case)
+    if L == 0:
+        applied, trial = fmin * u, (fmin + case.nu_s * V) * u
+        return Expect(1.0, tuple(-applied), tuple(-(trial + case.nu_s * np.array([0.0, V, 0.0])) / KS), 1)
+    n = math.floor(rest / L)
+    part = rest - n * L
+    bound = 100 * 8 * EPS * (T + rate)
+    assert bound < rate * min(part, L - part)  # n is not on the edge of a rounding
+    F = (fmin + rate * part) * u + (fmin / T) ** n * q * np.array([-1.0, 0.0, 0.0])
+    return Expect(1.0, tuple(-F), tuple(-F / KS), 1, tol=bound)
 
 
 def _inside_step(case):
@@ -349,7 +472,7 @@ def compare(case, trace):
             if e is None:
                 continue
             F, D = -vector(e.f, w), vector(e.d, w)
-            tol = case.ulps * np.spacing(max(np.abs(F).max(), np.abs(D).max()))
+            tol = e.tol if e.tol is not None else case.ulps * np.spacing(max(np.abs(F).max(), np.abs(D).max()))
             got = {q: None if trace[q] is None else trace[q][k] for q in ("fn", "F", "D", "slips")}
             where = f"{case.name}: step {k + 1}"
             assert got["fn"] == e.fn, (where, "Fn", got["fn"], e.fn)

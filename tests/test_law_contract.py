@@ -1,5 +1,7 @@
 """The law's contract on every engine (tests/law_contract.py): one-contact cases with
 exact numbers, each engine's record compared to hand-worked values to the ulp."""
+import math
+
 import numpy as np
 import pytest
 
@@ -39,3 +41,52 @@ def test_coefficients_per_type_pair(engine, timing):
     for pair, trace in traces.items():
         w = lc.X * (np.array([1.0, 0, 0]) if 1 in pair else np.array([0, 1.0, 0]))
         lc.compare_type_pair(pair, trace, w)
+
+
+def _stick_shares(case):
+    """The share of each step the contact spent sticking, as pyref's kernel reports it: the
+    dashpot's dissipation nu_s |V_s|^2 dt times that share (docs/law.md, Energy). The case's
+    wall contact driven step by step (the floor's normal is fixed: D needs no turn)."""
+    from pyref.laws import LawParams, tangential_force
+
+    p = LawParams("stick_slip", lc.KN, case.nu_n, lc.KS, case.nu_s, case.mu_s, case.mu_k, case.reset, case.timing)
+    D, shares = np.zeros((1, 3)), []
+    for seg in case.segments:
+        assert seg.delta == lc.DELTA and case.geometry == "wall"  # Fn = 1 throughout
+        V = np.array([lc.tangential(case, seg.velocity)])
+        for _ in range(seg.steps):
+            step = tangential_force(D, V, np.array([1.0]), lc.DT, p, energy=True)
+            D = step.spring
+            shares.append(step.dissipated_dashpot[0] / (case.nu_s * (V[0] @ V[0]) * lc.DT))
+    return np.array(shares)
+
+
+def _share_expected(name):
+    """Worked out by hand: a slip takes no time, so a step that slips inside and sticks again
+    stuck all of it; a step that slips at its very end stuck all of it; E4 and E6 slide
+    (stick 0) from their slip to the step's end."""
+    if name == "slip_inside_step_exact_timing_reset_spring":
+        return np.ones(30), 0.0
+    if name == "dashpot_keeps_it_sliding_exact_timing":
+        return np.r_[np.ones(8), np.zeros(4)], 0.0
+    if name == "plastic_flow_reset_total_inside_step_exact_timing":
+        theta = (math.sqrt(320.0) - 17.0) / 1.25  # the slip inside step 21 (law_contract._flow_after_hit)
+        return np.r_[np.ones(20), theta], 64 * lc.EPS  # (the root's cancellation: ~20 eps relative)
+    if name == "max_explicit_slips_slides_exact_timing":
+        theta = lc.max_slips_follow(CASE[name])[0]  # sticks between its 100 slips, then slides
+        return np.r_[np.ones(16), theta], 100 * 8 * lc.EPS * (1 + 1 / 4)  # (_max_slips_step's bound / rate)
+    raise KeyError(name)
+
+
+CASE = {c.name: c for c in lc.CASES}
+
+
+@pytest.mark.parametrize("name", ["slip_inside_step_exact_timing_reset_spring", "dashpot_keeps_it_sliding_exact_timing",
+                                  "plastic_flow_reset_total_inside_step_exact_timing",
+                                  "max_explicit_slips_slides_exact_timing"])
+def test_stick_share_exact_timing(name):
+    """The exact timing's share of the step spent sticking (pyref's kernel, which YADE runs;
+    it weighs the dashpot's dissipation), against hand-worked values."""
+    expected, tol = _share_expected(name)
+    got = _stick_shares(CASE[name])
+    assert np.all(np.abs(got - expected) <= tol), (name, got, expected)
