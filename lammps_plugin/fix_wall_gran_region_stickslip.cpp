@@ -16,6 +16,7 @@
 #include "neighbor.h"
 #include "region.h"
 #include "update.h"
+#include "rigid_mass.h"
 
 #include <cstring>
 
@@ -144,15 +145,7 @@ void FixWallGranRegionStickSlip::post_force(int)
 
   // rigid bodies: a grain of a rigid body moves with the body's mass (stock)
   if (neighbor->ago == 0 && fix_rigid) {
-    int unused;
-    int *body = (int *) fix_rigid->extract("body", unused);
-    double *mass_body = (double *) fix_rigid->extract("masstotal", unused);
-    if (atom->nmax > nmax) {
-      memory->destroy(mass_rigid);
-      nmax = atom->nmax;
-      memory->create(mass_rigid, nmax, "wall/gran:mass_rigid");
-    }
-    for (int i = 0; i < atom->nlocal; i++) mass_rigid[i] = body[i] >= 0 ? mass_body[body[i]] : 0.0;
+    StickSlip::refresh_rigid_mass(lmp, fix_rigid, mass_rigid, nmax, "wall/gran:mass_rigid");
   }
 
   // the region's place and velocity now (every rank evaluates its variables)

@@ -11,7 +11,6 @@ Costs (2-core machine under load): LAMMPS drag 0.5 s, tray (0.5 s simulated) 1 s
 2-4 s a timing; the pyref runs are shared with the LIGGGHTS and YADE tests (paper_case);
 the ranks test ~6 s, the drum ~3 s, the rest < 1 s each.
 """
-import math
 
 import numpy as np
 import pytest
@@ -20,9 +19,9 @@ from stickslip import analysis, columns
 from stickslip import scene as scene_mod
 from stickslip.adapters import lammps as lammps_adapter
 from conftest import needs_engine, paper_case
+from twin_bound import assert_round_off_apart
 
 needs_lammps = needs_engine("lammps")
-U = np.finfo(float).eps / 2  # unit round-off, 1.1e-16
 
 
 def run_lammps(name, tmp_path, ranks=1, **kw):
@@ -36,53 +35,14 @@ def pyref_case(name, timing, **kw):
 
 
 def assert_pyrefs_twin(sc, dl, dp):
-    """LAMMPS against pyref row by row, every column, to round-off (the bound of
-    tests/test_yade_engine.py, whose derivation holds here): at each step an engine may round
-    a coordinate differently, by u L (L: the largest coordinate a contact is computed from;
-    LAMMPS' region plate turns the grain's position into the plate's frame and the contact
-    point back, rotations about the pivot of coordinates of size L), and an overlap by up to
-    4 u L more; the dynamics is stable and dissipative, so these add up without growing:
-    after k steps positions differ by at most dx = (k + 4) u L, velocities by dv = w dx (w =
-    sqrt((Kn + Ks)/m_eff), the fastest contact frequency, m_eff half the lightest grain),
-    normal forces by Kn dx + nu_n dv, tangential ones by Ks dx + nu_s dv. Wall angles and
-    times come from the same formula: equal. Slips fall in the same steps wherever a normal
-    force acts (a slip moves only if the trial force ends a step within ~Ks dx of mu_s Fn;
-    it changes by Ks |V_s| dt, 1e5 times more, per step). A LAMMPS wall contact begins at
-    zero overlap (stock's rule, lammps_plugin/README.md) where pyref has none, and with
-    Fn = 0 it slips with zero force in every step: the tray's grain 1 starts exactly
-    touching the left wall, until grain 2 pushes it into the wall. So the slip counts are
-    compared over rows that begin and end with a normal force on both engines (a grain that
-    has overlapped a wall does not come back to exactly zero overlap)."""
-    assert list(dl.columns) == list(dp.columns) and len(dl) == len(dp)
-    c = sc.contact
-    k = (dp["t"].to_numpy() / sc.dt).round()  # steps made by each row
-    L = np.abs(dp[[col for col in dp.columns if col.endswith(("_x", "_y", "_z"))]].to_numpy()).max()
-    m_eff = min(sc.grain_mass(g) for g in sc.grains) / 2
-    dx = (k + 4) * U * L
-    dv = math.sqrt((c.kn + c.ks) / m_eff) * dx
-    nu_n = c.nu_n if sc.effects["normal_damping"] else 0.0
-    nu_s = c.nu_s if sc.effects["tangential_damping"] else 0.0
-    for col in dp.columns:
-        y, p = dl[col].to_numpy(), dp[col].to_numpy()
-        if col.endswith("_slip"):
-            fn = col[:-len("_slip")] + "_fn"
-            pressed = (dl[fn].to_numpy() > 0) & (dp[fn].to_numpy() > 0)
-            whole = pressed & np.concatenate(([False], pressed[:-1]))  # at the row and the one before
-            y, p, bound = y[whole], p[whole], np.zeros(whole.sum())
-        elif col == "t" or col.endswith("_angle"):
-            bound = np.zeros_like(k)
-        elif col.endswith(("_x", "_y", "_z")):
-            bound = dx
-        elif col.endswith(("_vx", "_vy", "_vz")):
-            bound = dv
-        elif col.endswith("_fn"):
-            bound = c.kn * dx + nu_n * dv
-        elif col.endswith(("_fs", "_ftx", "_fty", "_ftz")):
-            bound = c.ks * dx + nu_s * dv
-        else:
-            raise AssertionError(f"no bound for column {col}")
-        worst = int(np.argmax(np.abs(y - p) - bound))
-        assert np.all(np.abs(y - p) <= bound), (col, worst, y[worst], p[worst], bound[worst])
+    """LAMMPS against pyref row by row (tests/twin_bound.py's round-off bound; LAMMPS' region
+    plate turns the grain's position into the plate's frame and the contact point back).
+    A LAMMPS wall contact begins at zero overlap (stock's rule, lammps_plugin/README.md)
+    where pyref has none, and with Fn = 0 it slips with zero force in every step: the tray's
+    grain 1 starts exactly touching the left wall, until grain 2 pushes it into the wall. So
+    slip flags are compared over rows that begin and end with a normal force on both (a
+    grain that has overlapped a wall does not come back to exactly zero overlap)."""
+    assert_round_off_apart(sc, dl, dp, slips_where_pressed=True)
 
 
 # ---------------------------------------------------------------- the paper's cases, step for step

@@ -1,5 +1,4 @@
 """The YADE law against pyref on the paper's cases (issue 4), and its parameter errors."""
-import math
 import subprocess
 import sys
 from pathlib import Path
@@ -10,6 +9,7 @@ import pytest
 from stickslip import analysis
 from stickslip import scene as scene_mod
 from stickslip.adapters import yade as yade_adapter
+import twin_bound
 from conftest import needs_engine, paper_case, run_pyref
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -71,54 +71,19 @@ def pyref_case(name, slip_timing):
     return (paper_case(name) if slip_timing == "step" else paper_case(name, slip_timing=slip_timing))[1]
 
 
-U = np.finfo(float).eps / 2  # unit round-off, 1.1e-16
 BOX_HALF_THICKNESS = 0.01  # m: run_scene.py builds a turning wall as a box this thick
 
 
 def assert_round_off_apart(sc, dy, dp):
-    """YADE against pyref row by row, every column. Since issue 25 YADE starts as velocity
-    Verlet (yade_law/README.md, "Twin runs"), so both engines do the same arithmetic step
-    for step, in another order: they may differ by round-off only. Bound: at each step an
-    engine may round a coordinate differently, by u L (L: the largest coordinate a contact
-    is computed from: the grains', or the centre of a turning wall's box), and an overlap
-    by up to 4 u L more (a box turns the sphere's offset into its frame); the dynamics is
-    stable and dissipative, so such errors add up without growing (a perturbed oscillator
-    keeps its perturbation's amplitude): after k steps positions differ by at most
-    dx = (k + 4) u L and velocities by dv = w dx, w = sqrt((Kn + Ks)/m_eff) the fastest contact
-    frequency (m_eff: half the lightest grain); normal forces by Kn dx + nu_n dv, tangential
-    ones by Ks dx + nu_s dv, and slips fall in the same steps (a slip moves only if the
-    trial force ends a step within ~Ks dx of mu_s Fn; it changes by Ks |V_s| dt, 1e5 times
-    more, per step). The wall angles and times are computed by the same formula: equal.
-    The differences this replaced (YADE's whole first kick, its springs loaded at setup,
-    rows written a step early, a turning box's velocities) broke these bounds in every
-    column they touched, by 25 to 5e6 times (measured on the code before issue 25: the
-    drag's Fn 2.3e4 times, the tilt's x 3.5e5 times)."""
-    assert list(dy.columns) == list(dp.columns) and len(dy) == len(dp)
-    c = sc.contact
-    k = (dp["t"].to_numpy() / sc.dt).round()  # steps made by each row
-    L = max(max(np.abs(dp[[col for col in dp.columns if col.endswith(("_x", "_y", "_z"))]].to_numpy()).max(), 0.0),
-            BOX_HALF_THICKNESS if any(w.rotation for w in sc.walls) else 0.0)
-    m_eff = min(sc.grain_mass(g) for g in sc.grains) / 2
-    dx = (k + 4) * U * L
-    dv = math.sqrt((c.kn + c.ks) / m_eff) * dx
-    nu_n = c.nu_n if sc.effects["normal_damping"] else 0.0
-    nu_s = c.nu_s if sc.effects["tangential_damping"] else 0.0
-    for col in dp.columns:
-        y, p = dy[col].to_numpy(), dp[col].to_numpy()
-        if col == "t" or col.endswith(("_slip", "_angle")):
-            bound = np.zeros_like(k)
-        elif col.endswith(("_x", "_y", "_z")):
-            bound = dx
-        elif col.endswith(("_vx", "_vy", "_vz")):
-            bound = dv
-        elif col.endswith("_fn"):
-            bound = c.kn * dx + nu_n * dv
-        elif col.endswith(("_fs", "_ftx", "_fty", "_ftz")):
-            bound = c.ks * dx + nu_s * dv
-        else:
-            raise AssertionError(f"no bound for column {col}")
-        worst = int(np.argmax(np.abs(y - p) - bound))
-        assert np.all(np.abs(y - p) <= bound), (col, worst, y[worst], p[worst], bound[worst])
+    """YADE against pyref row by row, every column, within tests/twin_bound.py's round-off
+    bound (L at least a turning wall's box half thickness: the box turns the sphere's offset
+    into its frame). Since issue 25 YADE starts as velocity Verlet (yade_law/README.md, "Twin
+    runs"), so both engines do the same arithmetic step for step, in another order. The
+    differences this replaced (YADE's whole first kick, its springs loaded at setup, rows
+    written a step early, a turning box's velocities) broke these bounds in every column
+    they touched, by 25 to 5e6 times (measured on the code before issue 25: the drag's Fn
+    2.3e4 times, the tilt's x 3.5e5 times)."""
+    twin_bound.assert_round_off_apart(sc, dy, dp, BOX_HALF_THICKNESS if any(w.rotation for w in sc.walls) else 0.0)
 
 
 @needs_yade

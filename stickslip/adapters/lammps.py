@@ -29,11 +29,9 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
-from .. import columns
 from . import RunResult
-from .text_dumps import id_ranges, read_dump, slip_stats
+from .text_dumps import id_ranges, read_dump, timeseries
 
 NAME = "lammps"
 REPO = Path(__file__).resolve().parents[2]
@@ -309,29 +307,13 @@ class _Script:
 
 
 def _timeseries(script, work):
-    sc = script.scene
-    d = sc.dimension
-    atoms = read_dump(work / "atoms.dump")
     pairs = read_dump(work / "pairs.dump") if (work / "pairs.dump").is_file() else {}
-    steps = sorted(atoms)
-    # rows of the atoms dump: the recorded grains, sorted by id
-    row = {i: k for k, i in enumerate(script.recorded)}
-    for s in steps:
-        if len(atoms[s]) != len(row) or not np.array_equal(atoms[s][:, 0], script.recorded):
-            raise RuntimeError(f"LAMMPS: the dump at step {s} does not hold the recorded grains "
-                               f"(lost atoms?); see {work / 'screen.txt'}")
-    cols = {"t": [s * sc.dt for s in steps]}
-    spin = ([9] if d == 2 else [7, 8, 9]) if sc.effects["rotation"] else []
-    picks = [1 + k for k in range(d)] + [4 + k for k in range(d)] + spin  # id x y z vx vy vz omegax omegay omegaz
-    for name in sc.output.grains:
-        i = row[script.ids[name]]
-        blk = np.array([atoms[s][i] for s in steps])
-        cols.update(zip(columns.grain(name, d, sc.effects["rotation"]), blk[:, picks].T))
-    for a, b in sc.output.contacts:
+
+    def record(a, b, atoms, row, steps):
         ia = script.ids[a]
         rec = np.zeros((len(steps), 5))  # fn, fs (3), cumulative slips
         for r, s in enumerate(steps):
-            if b in script.walls:
+            if b in script.walls:  # the wall's per-atom record, 5 columns a wall after the grain's 10
                 base = 10 + 5 * script.walls_of.index(b)
                 rec[r] = atoms[s][row[ia]][base:base + 5]
                 continue
@@ -340,31 +322,8 @@ def _timeseries(script, work):
                 if {int(line[0]), int(line[1])} == {ia, ib}:
                     sign = 1.0 if int(line[0]) == ia else -1.0  # the record is the force on the first grain
                     rec[r] = [line[2], *(sign * line[3:6]), line[6]]
-        # slips since the previous row; a counter that drops means the contact was remade
-        count = rec[:, 4]
-        slips = np.diff(count, prepend=0.0)
-        slips = np.where(slips < 0, count, slips)
-        values = [rec[:, 0], np.linalg.norm(rec[:, 1:4], axis=1), *rec[:, 1:1 + d].T, np.rint(slips).astype(int)]
-        cols.update(zip(columns.contact(a, b, d), values))
-    for name in sc.output.walls:
-        w = next(w for w in sc.walls if w.name == name)
-        nrot = sc.rotation_steps(w) if w.rotation else 0
-        rate = sc.rotation_rate(w) if w.rotation else 0.0
-        cols[columns.wall(name)[0]] = [rate * sc.dt * min(s, nrot) for s in steps]
-    if sc.output.stats:
-        stats = read_dump(work / "stats.dump")
-        cols.update(zip(columns.STATS, ([int(round(stats[s][0][1])) for s in steps],
-                                        [float(stats[s][0][2]) for s in steps])))
-    if sc.output.slip_stats:
-        cols.update(zip(columns.SLIP_STATS, slip_stats(script, atoms, read_dump(work / "slips.dump"), steps, fn_col=2)))
-    df = pd.DataFrame(cols)
-    bad = ~np.isfinite(df.to_numpy(dtype=float))
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
-        raise RuntimeError(f"LAMMPS produced non-finite values: {df.columns[c]} = {df.iat[r, c]} at t = "
-                           f"{df['t'].iat[r]:.6g} s (step {steps[r]}); the run is not usable "
-                           f"(see {work / 'screen.txt'})")
-    return df
+        return rec
+    return timeseries("LAMMPS", script, work, record, slip_fn_col=2)
 
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):

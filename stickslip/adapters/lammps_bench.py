@@ -57,6 +57,7 @@ from pathlib import Path
 
 from .. import callgrind
 from ..ratio_interval import ratio_interval
+from .proc_probe import probe_script
 from .lammps import BUILD
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -114,22 +115,7 @@ run {steps} pre no post no
 
 # Appends the on-CPU time (ns) of the LAMMPS process that runs it through `shell` (its
 # nearest ancestor named lmp-stickslip) to probe.log. Shell built-ins only.
-PROBE = """\
-#!/bin/sh
-p=$PPID
-while [ "$p" -gt 1 ]; do
-  read -r line < /proc/$p/stat
-  case "$line" in
-    *"(lmp-stickslip)"*)
-      read -r s < /proc/$p/schedstat
-      echo "${s%% *}" >> probe.log
-      exit 0;;
-  esac
-  set -- ${line##*) }
-  p=$2
-done
-exit 1
-"""
+PROBE = probe_script("lmp-stickslip)", 'read -r s < /proc/$p/schedstat\necho "${s%% *}" >> probe.log')
 
 LOOP = re.compile(r"Loop time of (\S+) on (\d+) procs for (\d+) steps with (\d+) atoms")
 CPU_USE = re.compile(r"([\d.]+)% CPU use with")

@@ -20,12 +20,10 @@ import time
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
-from .. import columns
 from . import RunResult
 from .text_dumps import full_precision as _full_precision, id_ranges as _id_ranges, read_dump as _read_dump
-from .text_dumps import slip_stats
+from .text_dumps import timeseries
 
 NAME = "liggghts"
 REPO = Path(__file__).resolve().parents[2]
@@ -311,72 +309,33 @@ class _Script:
 
 
 def _timeseries(script, work):
-    sc = script.scene
-    d = sc.dimension
-    atoms = _read_dump(work / "atoms.dump")
     pairs = _read_dump(work / "pairs.dump") if (work / "pairs.dump").is_file() else {}
     walls = _read_dump(work / "walls.dump") if (work / "walls.dump").is_file() else {}
-    steps = sorted(atoms)
-    # rows of the atoms dump: the recorded grains, sorted by id
-    row = {i: k for k, i in enumerate(script.recorded)}
-    for s in steps:
-        if len(atoms[s]) != len(row) or not np.array_equal(atoms[s][:, 0], script.recorded):
-            raise RuntimeError(f"LIGGGHTS: the dump at step {s} does not hold the recorded grains "
-                               f"(lost atoms?); see {work / 'screen.txt'}")
-    cols = {"t": [s * sc.dt for s in steps]}
-    for name in sc.output.grains:
-        i = row[script.ids[name]]
-        blk = np.array([atoms[s][i] for s in steps])
-        # dump columns: id x y z vx vy vz omegax omegay omegaz
-        spin = ([9] if d == 2 else [7, 8, 9]) if sc.effects["rotation"] else []
-        picks = [1 + k for k in range(d)] + [4 + k for k in range(d)] + spin
-        cols.update(zip(columns.grain(name, d, sc.effects["rotation"]), blk[:, picks].T))
-    for a, b in sc.output.contacts:
+
+    def record(a, b, atoms, row, steps):
         ia = script.ids[a]
         rec = np.zeros((len(steps), 5))  # fn, fs (3), cumulative slips
         for r, s in enumerate(steps):
-            if b in script.primitive:
+            if b in script.primitive:  # the wall's per-atom history, 5 columns a wall after the grain's 10
                 base = 10 + 5 * script.walls_of.index(b)
                 rec[r] = atoms[s][row[ia]][base:base + 5]
-            else:
-                blk = pairs.get(s) if b in script.ids else walls.get(s)
-                if blk is None or not len(blk):
-                    continue
-                if b in script.ids:
-                    ib = script.ids[b]
-                    for line in blk:
-                        if {int(line[0]), int(line[1])} == {ia, ib}:
-                            sign = 1.0 if int(line[0]) == ia else -1.0  # the record is the force on the first grain
-                            rec[r] = [line[3], *(sign * line[4:7]), line[7]]
-                else:  # a mesh wall: one row per touched triangle, summed
-                    for line in blk[blk[:, 2].astype(int) == ia]:
-                        rec[r, :4] += line[3:7]
-                        rec[r, 4] += line[7]
-        # slips since the previous row; a counter that drops means the contact was remade
-        count = rec[:, 4]
-        slips = np.diff(count, prepend=0.0)
-        slips = np.where(slips < 0, count, slips)
-        values = [rec[:, 0], np.linalg.norm(rec[:, 1:4], axis=1), *rec[:, 1:1 + d].T, np.rint(slips).astype(int)]
-        cols.update(zip(columns.contact(a, b, d), values))
-    for name in sc.output.walls:
-        w = next(w for w in sc.walls if w.name == name)
-        nrot = sc.rotation_steps(w) if w.rotation else 0
-        rate = sc.rotation_rate(w) if w.rotation else 0.0
-        cols[columns.wall(name)[0]] = [rate * sc.dt * min(s, nrot) for s in steps]
-    if sc.output.stats:
-        stats = _read_dump(work / "stats.dump")
-        cols.update(zip(columns.STATS, ([int(round(stats[s][0][1])) for s in steps],
-                                        [float(stats[s][0][2]) for s in steps])))
-    if sc.output.slip_stats:
-        slips = _read_dump(work / "slips.dump")  # id1 id2 - Fn F_s(3) count
-        cols.update(zip(columns.SLIP_STATS, slip_stats(script, atoms, slips, steps, fn_col=3)))
-    df = pd.DataFrame(cols)
-    bad = ~np.isfinite(df.to_numpy(dtype=float))
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
-        raise RuntimeError(f"LIGGGHTS produced non-finite values: {df.columns[c]} = {df.iat[r, c]} at t = "
-                           f"{df['t'].iat[r]:.6g} s (step {steps[r]}); the run is not usable (see {work / 'screen.txt'})")
-    return df
+                continue
+            blk = pairs.get(s) if b in script.ids else walls.get(s)
+            if blk is None or not len(blk):
+                continue
+            if b in script.ids:
+                ib = script.ids[b]
+                for line in blk:
+                    if {int(line[0]), int(line[1])} == {ia, ib}:
+                        sign = 1.0 if int(line[0]) == ia else -1.0  # the record is the force on the first grain
+                        rec[r] = [line[3], *(sign * line[4:7]), line[7]]
+            else:  # a mesh wall: one row per touched triangle, summed
+                for line in blk[blk[:, 2].astype(int) == ia]:
+                    rec[r, :4] += line[3:7]
+                    rec[r, 4] += line[7]
+        return rec
+    # slips.dump: id1 id2 - Fn F_s(3) count
+    return timeseries("LIGGGHTS", script, work, record, slip_fn_col=3)
 
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):

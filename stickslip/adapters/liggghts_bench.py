@@ -56,6 +56,7 @@ from pathlib import Path
 
 from .. import callgrind
 from ..ratio_interval import ratio_interval
+from .proc_probe import probe_script
 from .liggghts import BUILD, LAUNCHER
 
 CACHE = BUILD.parent / "liggghts_bench"
@@ -142,25 +143,13 @@ run {warm}
 # it looks for the launcher among its ancestors), the uptime (s) and the machine's CPU line
 # (/proc/stat), then waits until the benchmark writes a line into go.fifo. Shell built-ins
 # only: the probe itself should cost next to nothing.
-PROBE = """\
-#!/bin/sh
-p=$PPID
-while [ "$p" -gt 1 ]; do
-  read -r line < /proc/$p/stat
-  case "$line" in
-    *"(liggghts-stick"*)
-      read -r s < /proc/$p/schedstat; read -r u < /proc/uptime; read -r c < /proc/stat
-      echo "$s | $u | $c" >> probe.log
-      read -r go < go.fifo
-      read -r s < /proc/$p/schedstat; read -r u < /proc/uptime; read -r c < /proc/stat
-      echo "$s | $u | $c" >> probe.log
-      exit 0;;
-  esac
-  set -- ${line##*) }
-  p=$2
-done
-exit 1
-"""
+PROBE = probe_script("liggghts-stick", """
+read -r s < /proc/$p/schedstat; read -r u < /proc/uptime; read -r c < /proc/stat
+echo "$s | $u | $c" >> probe.log
+read -r go < go.fifo
+read -r s < /proc/$p/schedstat; read -r u < /proc/uptime; read -r c < /proc/stat
+echo "$s | $u | $c" >> probe.log
+""")
 
 
 def _chunked(chunks, chunk):
@@ -210,7 +199,8 @@ OVERHEAD = ("history", "stick_slip", "stick_slip_exact")
 STAMPLESS = "stick_slip_keep"
 LABEL = {"history": "stock tangential history", "stick_slip": "tangential stick_slip",
          "stick_slip_exact": "tangential stick_slip exact_slip_timing on",
-         "stick_slip_keep": "tangential stick_slip history_on_separation keep (no stamp)"}
+         "stick_slip_keep": "tangential stick_slip history_on_separation keep (no stamp)",
+         "control": "stock history compiled in the plugin (control build)"}
 TARGET = {"stick_slip": 1.02, "stick_slip_exact": 1.05}  # issue 32: at most this many times history's cost
 
 LAST_ROUNDS = []  # the overhead runs behind the last benchmark() figures: per round, {config: run}
@@ -526,10 +516,12 @@ def _timed(data, tang, nproc, work):
             "coordination": 2 * contacts / atoms, "rss_mib": rss, "foreign_cores": info.get("foreign_cores")}
 
 
-def benchmark(reps=3, rounds=ROUNDS, counts=True, baseline=None, stamp_cost=False):
+def benchmark(reps=3, rounds=ROUNDS, counts=True, baseline=None, stamp_cost=False, control=None):
     """Rows for `stickslip bench` (see the module docstring). `baseline`: another build's
     launcher, whose stick_slip (both timings) joins the rounds and the counts, for A/B
-    comparisons of two builds. `stamp_cost`: stick_slip without its stamp joins them too."""
+    comparisons of two builds. `stamp_cost`: stick_slip without its stamp joins them too.
+    `control`: the launcher of a control build (liggghts_plugin/control_stock_history.h),
+    whose `stick_slip` is stock history compiled into the plugin."""
     _check()
     reps, rounds = max(1, int(reps)), max(1, int(rounds))
     data = _packing()
@@ -538,6 +530,8 @@ def benchmark(reps=3, rounds=ROUNDS, counts=True, baseline=None, stamp_cost=Fals
         configs.update({f"{name}@baseline": (name, Path(baseline)) for name in OVERHEAD[1:]})
     if stamp_cost:
         configs[STAMPLESS] = (STAMPLESS, LAUNCHER)
+    if control is not None:
+        configs["control"] = ("stick_slip", Path(control))
     rows = []
     with tempfile.TemporaryDirectory(prefix="liggghts_bench-") as work:
         work = Path(work)
@@ -572,6 +566,8 @@ def benchmark(reps=3, rounds=ROUNDS, counts=True, baseline=None, stamp_cost=Fals
     ratios.append(("stick_slip_exact", "stick_slip"))
     if stamp_cost:
         ratios.append(("stick_slip", STAMPLESS))
+    if control is not None:
+        ratios += [("control", "history"), ("stick_slip", "control"), ("stick_slip_exact", "control")]
     if baseline is not None:
         ratios += [(name, f"{name}@baseline") for name in OVERHEAD[1:]]
     for num, den in ratios:
@@ -677,17 +673,23 @@ def main(argv=None):
     ap.add_argument("--reps", type=int, default=3, help="MPI repetitions (median quoted)")
     ap.add_argument("--no-callgrind", action="store_true", help="skip the instruction counts")
     ap.add_argument("--baseline", type=Path, help="another build's liggghts-stickslip, compared in the same rounds")
+    ap.add_argument("--control", type=Path, help="a control build's liggghts-stickslip (liggghts_plugin/"
+                    "control_stock_history.h): stock history compiled in the plugin, in the same rounds")
     ap.add_argument("--stamp-cost", action="store_true",
                     help="also run stick_slip with history_on_separation keep (no stamp history value)")
     a = ap.parse_args(argv)
     if a.rounds < 1 or a.reps < 1:
         ap.error("--rounds and --reps must be >= 1")
+    for opt, path in (("--baseline", a.baseline), ("--control", a.control)):
+        if path is not None and not path.is_file():
+            ap.error(f"{opt} {path}: no such file (a built liggghts-stickslip)")
     if a.baseline is not None and not a.baseline.is_file():
         ap.error(f"--baseline {a.baseline}: no such file (a built liggghts-stickslip)")
     t0 = time.perf_counter()
     try:
         rows = benchmark(a.reps, a.rounds, counts=not a.no_callgrind,
-                         baseline=a.baseline.resolve() if a.baseline else None, stamp_cost=a.stamp_cost)
+                         baseline=a.baseline.resolve() if a.baseline else None, stamp_cost=a.stamp_cost,
+                         control=a.control.resolve() if a.control else None)
     except RuntimeError as e:
         sys.stderr.write(f"liggghts_bench: {e}\n")
         return 1

@@ -6,6 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from .. import columns
+
 
 def full_precision(dump, ncols, ints=0):
     """Dumps print 6 digits by default; forces and positions are compared far below that."""
@@ -110,3 +112,57 @@ def id_ranges(ids):
             parts.append(str(start) if start == prev else f"{start}:{prev}")
             start = cur
     return " ".join(parts)
+
+
+def timeseries(engine, script, work, contact_record, slip_fn_col):
+    """The timeseries frame (stickslip/columns.py) from the dumps a LAMMPS-family script
+    wrote into `work`: atoms.dump (the recorded grains: id x y z vx vy vz omegax omegay omegaz,
+    then the engine's per-wall records), stats.dump and slips.dump when the scene asks.
+    contact_record(a, b, atoms, row, steps): the engine's record of contact a-b at each
+    step, (steps, 5): Fn, the force on a (3), the slips counted since the contact began
+    (`row` maps an atom id to its row of the atoms dump). slip_fn_col: Fn's column in
+    slips.dump. A non-finite value stops with one line naming the column, time and step."""
+    sc = script.scene
+    d = sc.dimension
+    atoms = read_dump(work / "atoms.dump")
+    steps = sorted(atoms)
+    row = {i: k for k, i in enumerate(script.recorded)}  # the atoms dump is sorted by id
+    for s in steps:
+        if len(atoms[s]) != len(row) or not np.array_equal(atoms[s][:, 0], script.recorded):
+            raise RuntimeError(f"{engine}: the dump at step {s} does not hold the recorded grains "
+                               f"(lost atoms?); see {work / 'screen.txt'}")
+    cols = {"t": [s * sc.dt for s in steps]}
+    spin = ([9] if d == 2 else [7, 8, 9]) if sc.effects["rotation"] else []
+    picks = [1 + k for k in range(d)] + [4 + k for k in range(d)] + spin
+    for name in sc.output.grains:
+        i = row[script.ids[name]]
+        blk = np.array([atoms[s][i] for s in steps])
+        cols.update(zip(columns.grain(name, d, sc.effects["rotation"]), blk[:, picks].T))
+    for a, b in sc.output.contacts:
+        rec = contact_record(a, b, atoms, row, steps)
+        # slips since the previous row; a counter that drops means the contact was remade
+        count = rec[:, 4]
+        slips = np.diff(count, prepend=0.0)
+        slips = np.where(slips < 0, count, slips)
+        values = [rec[:, 0], np.linalg.norm(rec[:, 1:4], axis=1), *rec[:, 1:1 + d].T, np.rint(slips).astype(int)]
+        cols.update(zip(columns.contact(a, b, d), values))
+    for name in sc.output.walls:
+        w = next(w for w in sc.walls if w.name == name)
+        nrot = sc.rotation_steps(w) if w.rotation else 0
+        rate = sc.rotation_rate(w) if w.rotation else 0.0
+        cols[columns.wall(name)[0]] = [rate * sc.dt * min(s, nrot) for s in steps]
+    if sc.output.stats:
+        stats = read_dump(work / "stats.dump")
+        cols.update(zip(columns.STATS, ([int(round(stats[s][0][1])) for s in steps],
+                                        [float(stats[s][0][2]) for s in steps])))
+    if sc.output.slip_stats:
+        cols.update(zip(columns.SLIP_STATS,
+                        slip_stats(script, atoms, read_dump(work / "slips.dump"), steps, fn_col=slip_fn_col)))
+    df = pd.DataFrame(cols)
+    bad = ~np.isfinite(df.to_numpy(dtype=float))
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise RuntimeError(f"{engine} produced non-finite values: {df.columns[c]} = {df.iat[r, c]} at t = "
+                           f"{df['t'].iat[r]:.6g} s (step {steps[r]}); the run is not usable "
+                           f"(see {work / 'screen.txt'})")
+    return df
