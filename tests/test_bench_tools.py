@@ -157,3 +157,29 @@ def test_callgrind_instruction_lines_name_each_instructions_function_file_and_li
                    0x1C: ("f", "/src/b.h", 10, 5), 0x20: ("f", "/src/b.h", 11, 2),
                    0x24: ("f", "/src/a.cpp", 5, 2), 0x40: ("g", "/src/b.h", 7, 7)}
     assert set(callgrind.instruction_lines(p, lambda f: f.endswith(".h"))) == {0x1C, 0x20, 0x40}
+
+
+def test_liggghts_bench_round_ratios_are_each_rounds_geometric_mean_of_quiet_blocks():
+    """liggghts_bench takes the round as the interval's unit: per round the geometric mean
+    of its quiet blocks' ratios (a noisy block left out, a round without a quiet one left
+    out). Two rounds of made-up chunks, the ratios worked out by hand."""
+    from stickslip.adapters import liggghts_bench as lb
+
+    def run(cpus, foreign):
+        return {"chunks": [{"cpu": c * lb.CHUNK, "foreign": f} for c, f in zip(cpus, foreign)]}
+    n = lb.CHUNKS
+    quiet, noisy = [0.0] * n, [lb.NOISY * 2] * n
+    # round 1: ratios 2 and 8 alternating (geometric mean 4), one noisy block of ratio 100
+    a1 = [1.0] * n
+    b1 = [2.0 if k % 2 == 0 else 8.0 for k in range(n)]
+    b1[5], f1 = 100.0, quiet.copy()
+    f1[5] = lb.NOISY * 2
+    round1 = {"history": run(a1, f1), "stick_slip": run(b1, quiet)}
+    round2 = {"history": run([1.0] * n, noisy), "stick_slip": run([3.0] * n, quiet)}  # no quiet block
+    round3 = {"history": run([2.0] * n, quiet), "stick_slip": run([3.0] * n, quiet)}
+    got = lb._round_ratios([round1, round2, round3], "stick_slip", "history", quiet_only=True)
+    # round 1 without block 5: 19 blocks of 8 and 20 of 2 -> exp((19 ln 8 + 20 ln 2)/39)
+    assert got[0] == pytest.approx(math.exp((19 * math.log(8) + 20 * math.log(2)) / 39), rel=1e-12)
+    assert got[1:] == [pytest.approx(1.5, rel=1e-12)] and len(got) == 2
+    every = lb._round_ratios([round1, round2, round3], "stick_slip", "history", quiet_only=False)
+    assert len(every) == 3 and every[1] == pytest.approx(3.0, rel=1e-12)

@@ -62,6 +62,22 @@ class Engine:
     cmake_args: tuple = ()  # configure arguments beyond the build type
 
 
+def exact_path_mutants(file=""):
+    """Mutants of the exact timing's E6 and E7 paths, whose text both engines share."""
+    return (
+        Mutant("flow_not_at_right_angle", "E6 (plastic flow) left out at t.u = 0",
+               "if (flow_law && along >= 0.0)", "if (flow_law && along > 0.0)", file=file),
+        Mutant("flow_rest_inverted", "E6 (plastic flow) over the wrong share of the step",
+               "plastic_flow(F, u, rate * rest / T, T);", "plastic_flow(F, u, rate / rest / T, T);", file=file),
+        Mutant("max_slips_counted_twice", "exact timing's closed form (E7) after 50 slips, not 100",
+               "slips++;", "slips += 2;", file=file),
+        Mutant("periodic_across_sign", "E7's closed form with the part across u turned",
+               "+ shrink * q[k];", "- shrink * q[k];", file=file),
+        Mutant("slid_at_zero_cycle", "E7 with a cycle of length 0 taken as periodic",
+               "if (!(L > 0.0)) {", "if (!(L >= 0.0)) {", file=file),
+    )
+
+
 LIGGGHTS_MUTANTS = (
     Mutant("fmin_step_0.3pct", "Fmin off by 0.3 %",
            "const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;",
@@ -114,20 +130,11 @@ LIGGGHTS_MUTANTS = (
     Mutant("wall_close_keeps_spring", "re-contact does not start from a zero spring",
            "hist[0] = hist[1] = hist[2] = 0.0;", ""),
     Mutant("fn_signed", "|Fn| for a tensile Fn",
-           "const double fn = std::fabs(sidata.Fn);", "const double fn = sidata.Fn;"),    Mutant("flow_not_at_right_angle", "E6 (plastic flow) left out at t.u = 0",
-           "if (flow_law && along >= 0.0)", "if (flow_law && along > 0.0)"),
-    Mutant("flow_rest_inverted", "E6 (plastic flow) over the wrong share of the step",
-           "plastic_flow(F, u, rate * rest / T, T);", "plastic_flow(F, u, rate / rest / T, T);"),
-    Mutant("max_slips_counted_twice", "exact timing's closed form (E7) after 50 slips, not 100",
-           "slips++;", "slips += 2;"),
-    Mutant("periodic_across_sign", "E7's closed form with the part across u turned",
-           "+ shrink * q[k];", "- shrink * q[k];"),
-    Mutant("slid_at_zero_cycle", "E7 with a cycle of length 0 taken as periodic",
-           "if (!(L > 0.0)) {", "if (!(L >= 0.0)) {"),
+           "const double fn = std::fabs(sidata.Fn);", "const double fn = sidata.Fn;"),
     Mutant("flow_ignores_reset_total", "the reset rule `total` ignored",
            "const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);",
            "const bool flow_law = r == 1.0 && gammat == 0.0;"),
-)
+) + exact_path_mutants()
 
 # LAMMPS: the law is stick_slip_law.h (steps 3-5, the inline E4 of the exact timing),
 # exact_slip_timing.h (E1-E7), and the pair style's and wall's code around it (coefficients
@@ -199,20 +206,11 @@ LAMMPS_MUTANTS = (
     Mutant("recontact_keeps_spring_wall", "re-contact does not start from a zero spring",
            "[m] = 0.0; continue;", "[m] += 0.0; continue;", file=WALL_CPP),
     Mutant("fn_signed", "|Fn| for a tensile Fn",
-           "const double fnabs = std::fabs(ccel_r);", "const double fnabs = ccel_r;"),    Mutant("flow_not_at_right_angle", "E6 (plastic flow) left out at t.u = 0",
-           "if (flow_law && along >= 0.0)", "if (flow_law && along > 0.0)", file=EXACT_H),
-    Mutant("flow_rest_inverted", "E6 (plastic flow) over the wrong share of the step",
-           "plastic_flow(F, u, rate * rest / T, T);", "plastic_flow(F, u, rate / rest / T, T);", file=EXACT_H),
-    Mutant("max_slips_counted_twice", "exact timing's closed form (E7) after 50 slips, not 100",
-           "slips++;", "slips += 2;", file=EXACT_H),
-    Mutant("periodic_across_sign", "E7's closed form with the part across u turned",
-           "+ shrink * q[k];", "- shrink * q[k];", file=EXACT_H),
-    Mutant("slid_at_zero_cycle", "E7 with a cycle of length 0 taken as periodic",
-           "if (!(L > 0.0)) {", "if (!(L >= 0.0)) {", file=EXACT_H),
+           "const double fnabs = std::fabs(ccel_r);", "const double fnabs = ccel_r;"),
     Mutant("flow_ignores_reset_total", "the reset rule `total` ignored",
            "const bool flow_law = c.ratio == 1.0 && (s.reset_total || nu_s == 0.0);",
            "const bool flow_law = c.ratio == 1.0 && nu_s == 0.0;"),
-)
+) + exact_path_mutants(EXACT_H)
 
 ENGINES = {
     "liggghts": Engine(
