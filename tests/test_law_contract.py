@@ -90,3 +90,24 @@ def test_stick_share_exact_timing(name):
     expected, tol = _share_expected(name)
     got = _stick_shares(CASE[name])
     assert np.all(np.abs(got - expected) <= tol), (name, got, expected)
+
+
+@pytest.mark.parametrize("timing", ["step", "exact"])
+def test_kernel_off_the_tables_units(timing):
+    """Two values the table cannot reach (Ks = 1 and mu_s Fn < 2 there), on pyref's kernel.
+    (a) Ks = 2: a spring of 15/64 plus V dt = 1/64 gives |F_t| = 2 * 16/64 = T = 1/2 at the
+    step's end: it slips to Fmin = (2 * 3/8 - 1/2) * 1 = 1/4 and the spring holds Fmin/Ks =
+    1/8 (eq. 8; exact: E3-E7 with nothing of the step left). (b) T = 4 (Fn = 8): nu_s |V| =
+    1, spring 3 - 1/64: the trial force meets T at the step's end, restarts at Fmin + nu_s|V|
+    = 2 + 1 = 3 < T, so it does not slide (E4 needs |F| >= T): exact timing applies 3, step
+    timing Fmin = 2; the spring 2 in both."""
+    from pyref.laws import LawParams, tangential_force
+
+    V = np.array([[0.25, 0.0, 0.0]])
+    p = LawParams("stick_slip", 32.0, 0.0, 2.0, 0.0, 0.5, 0.375, "spring", timing)
+    s = tangential_force(np.array([[15 / 64, 0.0, 0.0]]), V, np.array([1.0]), lc.DT, p)
+    assert s.slipped.all() and np.array_equal(s.force, [[-0.25, 0, 0]]) and np.array_equal(s.spring, [[0.125, 0, 0]])
+    p = LawParams("stick_slip", 32.0, 0.0, 1.0, 4.0, 0.5, 0.375, "spring", timing)
+    s = tangential_force(np.array([[3 - 1 / 64, 0.0, 0.0]]), V, np.array([8.0]), lc.DT, p)
+    applied = 3.0 if timing == "exact" else 2.0
+    assert s.slipped.all() and np.array_equal(s.force, [[-applied, 0, 0]]) and np.array_equal(s.spring, [[2.0, 0, 0]])
