@@ -94,7 +94,8 @@ def test_stick_share_exact_timing(name):
 
 @pytest.mark.parametrize("timing", ["step", "exact"])
 def test_kernel_off_the_tables_units(timing):
-    """Two values the table cannot reach (Ks = 1 and mu_s Fn < 2 there), on pyref's kernel.
+    """Two values the table cannot reach (Ks = 1 and mu_s Fn < 2 there), on pyref's kernel
+    (and the energy with Ks = 2).
     (a) Ks = 2: a spring of 15/64 plus V dt = 1/64 gives |F_t| = 2 * 16/64 = T = 1/2 at the
     step's end: it slips to Fmin = (2 * 3/8 - 1/2) * 1 = 1/4 and the spring holds Fmin/Ks =
     1/8 (eq. 8; exact: E3-E7 with nothing of the step left). (b) T = 4 (Fn = 8): nu_s |V| =
@@ -105,8 +106,11 @@ def test_kernel_off_the_tables_units(timing):
 
     V = np.array([[0.25, 0.0, 0.0]])
     p = LawParams("stick_slip", 32.0, 0.0, 2.0, 0.0, 0.5, 0.375, "spring", timing)
-    s = tangential_force(np.array([[15 / 64, 0.0, 0.0]]), V, np.array([1.0]), lc.DT, p)
+    s = tangential_force(np.array([[15 / 64, 0.0, 0.0]]), V, np.array([1.0]), lc.DT, p, energy=True)
     assert s.slipped.all() and np.array_equal(s.force, [[-0.25, 0, 0]]) and np.array_equal(s.spring, [[0.125, 0, 0]])
+    # energy with Ks = 2: received -F.V dt, the spring's store Ks(|D|^2 - |D0|^2)/2 given back; no dashpot
+    received, stored = 0.25 * 0.25 * lc.DT, 0.5 * 2.0 * (0.125 ** 2 - (15 / 64) ** 2)
+    assert s.dissipated_dashpot[0] == 0.0 and s.dissipated_slip[0] == received - stored
     p = LawParams("stick_slip", 32.0, 0.0, 1.0, 4.0, 0.5, 0.375, "spring", timing)
     s = tangential_force(np.array([[3 - 1 / 64, 0.0, 0.0]]), V, np.array([8.0]), lc.DT, p)
     applied = 3.0 if timing == "exact" else 2.0

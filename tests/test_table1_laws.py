@@ -25,7 +25,7 @@ def test_coulomb_opposes_the_sliding_direction_with_mu_k_fn():
     step; all the work -F.V dt is the slip's, none the dashpot's."""
     s = tangential_force(D0, V, FN, DT, params("coulomb"), energy=True)
     assert np.array_equal(s.force, [[-0.375, 0, 0], [0, 0.75, 0], [0, 0, 0]])
-    assert np.array_equal(s.spring, D0) and not s.slipped.any()
+    assert np.array_equal(s.spring, D0) and s.slipped.dtype == bool and not s.slipped.any()
     work = np.array([0.375 * 0.25, 0.75 * 0.5, 0.0]) * DT  # -F.V dt
     assert np.array_equal(s.dissipated_slip, work) and np.array_equal(s.dissipated_dashpot, np.zeros(3))
 
@@ -41,6 +41,10 @@ def test_visco_plastic_is_the_smaller_of_the_dashpot_and_mu_k_fn():
     assert np.array_equal(s.spring, D0) and not s.slipped.any()
     capped = tangential_force(D0, V, FN, DT, params("visco_plastic", nu_s=2.0))
     assert np.array_equal(capped.force, [[-0.375, 0, 0], [0, 0.75, 0], [0, 0, 0]])
+    # energy only when asked (both classic laws)
+    assert capped.dissipated_dashpot is None and capped.dissipated_slip is None
+    plain = tangential_force(D0, V, FN, DT, params("coulomb"))
+    assert plain.dissipated_dashpot is None and plain.dissipated_slip is None
 
 
 def test_visco_elastic_slips_at_mu_k_fn_and_stays_there():
