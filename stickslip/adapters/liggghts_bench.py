@@ -37,6 +37,11 @@ steps on 2 processes). On a busy machine everything is slower, and the rounds ad
 want of quiet blocks (up to 3 x) add to it.
 
     python -m stickslip.adapters.liggghts_bench [--rounds 5] [--reps 3] [--no-callgrind] [--baseline LAUNCHER]
+        [--control LAUNCHER] [--stamp-cost]
+
+--control: a control build's launcher (liggghts_plugin/control_stock_history.h: stock history
+compiled into the plugin) joins the rounds, so that the law is also compared with stock's
+arithmetic built as the plugin is; --stamp-cost: stick_slip without its stamp joins them.
 """
 from __future__ import annotations
 
