@@ -27,6 +27,14 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 #include <cmath>
 #include <cstdio>
 
+// A loop over x, y, z, unrolled where GCC still decides which values live in registers:
+// left as loops, the law's small arrays (D, F, V_s, ...) stayed on the stack, and every
+// contact's D and F went there and back on the chain that decides the slip (issue 32,
+// time against the control build: with the loops vectorised, pairs read back from single
+// stores, 1.13; not vectorised (CMakeLists.txt), 1.03; unrolled too, 1.01 and no stack
+// access on the common path). The same operations in the same order: the same bits.
+#define FOR_XYZ(k) _Pragma("GCC unroll 3") for (int k = 0; k < 3; k++)
+
 namespace LIGGGHTS {
 namespace ContactModels {
 
@@ -93,11 +101,11 @@ namespace StickSlip {
   {
     const double f = dot(F, u);
     double q[3];
-    for (int k = 0; k < 3; k++) q[k] = F[k] - f * u[k];
+    FOR_XYZ(k) q[k] = F[k] - f * u[k];
     const double qn = std::sqrt(dot(q, q));
     const double s = qn / (T + f) * std::exp(-k_rest);  // tan(phi/2) at the end (f >= 0 here)
     const double c = (1.0 - s * s) / (1.0 + s * s), sn = 2.0 * s / (1.0 + s * s);
-    for (int k = 0; k < 3; k++) F[k] = (T * c) * u[k] + (T * sn) * (qn > 0.0 ? q[k] / qn : 0.0);
+    FOR_XYZ(k) F[k] = (T * c) * u[k] + (T * sn) * (qn > 0.0 ? q[k] / qn : 0.0);
   }
 
   /* One step of a contact in which at least one slip happens (eqs. 5, 7, 8 integrated over
@@ -114,7 +122,7 @@ namespace StickSlip {
   {
     const double speed = std::sqrt(dot(vs, vs));
     double u[3];
-    for (int k = 0; k < 3; k++) u[k] = speed > 0.0 ? -vs[k] / speed : 0.0;
+    FOR_XYZ(k) u[k] = speed > 0.0 ? -vs[k] / speed : 0.0;
     const double rate = kt * speed * dt;
     // after a slip the trial force restarts from Fmin t + kept u (E3): the spring holds Fmin
     // and the dashpot adds nu_s |V_s| (default reset), or both hold Fmin (slip_reset_total)
@@ -122,7 +130,7 @@ namespace StickSlip {
     stick = 0.0;
     if (!(T > 0.0)) {  // E1: no normal force, no friction; the spring keeps what the reset leaves
       STICK_SLIP_COUNT(GEN_E1);
-      for (int k = 0; k < 3; k++) { applied[k] = 0.0; trial[k] = kept * u[k]; }
+      FOR_XYZ(k) { applied[k] = 0.0; trial[k] = kept * u[k]; }
       return;
     }
     double F[3] = { F0[0], F0[1], F0[2] };
@@ -140,32 +148,32 @@ namespace StickSlip {
       if (!(theta + dtheta <= 1.0)) {  // sticks to the end of the step
         STICK_SLIP_COUNT(GEN_STICK_TO_END);
         const double rest = 1.0 - theta;
-        for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];
+        FOR_XYZ(k) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];
         stick += rest;
         return;
       }
       double hit[3];
-      for (int k = 0; k < 3; k++) hit[k] = F[k] + (rate * dtheta) * u[k];
+      FOR_XYZ(k) hit[k] = F[k] + (rate * dtheta) * u[k];
       stick += dtheta;
       theta += dtheta;
       // E3: the slip; the force drops to Fmin along its direction t, the spring is reset (eq. 8)
       const double hn = std::sqrt(dot(hit, hit));
       double t[3];
-      for (int k = 0; k < 3; k++) t[k] = hit[k] / hn;
+      FOR_XYZ(k) t[k] = hit[k] / hn;
       slips++;
       STICK_SLIP_COUNT(GEN_SLIP);
-      for (int k = 0; k < 3; k++) F[k] = fmin * t[k] + kept * u[k];
+      FOR_XYZ(k) F[k] = fmin * t[k] + kept * u[k];
       const double rest = 1.0 - theta;
       // E4: the restarted force is at or above T again: slips follow without end and turn t
       // onto u, the contact slides at Fmin u for the rest of the step
       if (kept > 0.0 && dot(F, F) >= T * T) {
         STICK_SLIP_COUNT(GEN_E4);
-        for (int k = 0; k < 3; k++) { trial[k] = (fmin + kept) * u[k]; applied[k] = fmin * u[k]; }
+        FOR_XYZ(k) { trial[k] = (fmin + kept) * u[k]; applied[k] = fmin * u[k]; }
         return;
       }
       if (rate == 0.0) {  // E5: nothing moves, the force stays where the slip left it
         STICK_SLIP_COUNT(GEN_E5);
-        for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
+        FOR_XYZ(k) applied[k] = trial[k] = F[k];
         stick += rest;
         return;
       }
@@ -175,7 +183,7 @@ namespace StickSlip {
       if (flow_law && along >= 0.0) {  // E6: plastic flow on |F| = T
         STICK_SLIP_COUNT(GEN_E6);
         plastic_flow(F, u, rate * rest / T, T);
-        for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k];
+        FOR_XYZ(k) applied[k] = trial[k] = F[k];
         return;
       }
       // E7: settled along u (or followed MAX_EXPLICIT_SLIPS times): the remaining slips of
@@ -183,19 +191,19 @@ namespace StickSlip {
       // the force across u shrinks by r at each slip
       const double fu = dot(F, u);
       double q[3];
-      for (int k = 0; k < 3; k++) q[k] = F[k] - fu * u[k];
+      FOR_XYZ(k) q[k] = F[k] - fu * u[k];
       if ((std::sqrt(dot(q, q)) <= SETTLED * T && along > 0.0) || slips >= MAX_EXPLICIT_SLIPS) {
         STICK_SLIP_COUNT(GEN_E7);
         const double low = fmin + kept;
         const double L = (T - low) / rate;
         if (!(L > 0.0)) {  // restarts at T: slides, as E4
-          for (int k = 0; k < 3; k++) { trial[k] = low * u[k]; applied[k] = fmin * u[k]; }
+          FOR_XYZ(k) { trial[k] = low * u[k]; applied[k] = fmin * u[k]; }
           return;
         }
         const double n = std::floor(rest / L);
         const double part = rest - n * L;
         const double shrink = n == 0.0 ? 1.0 : std::pow(r, n);  // (no whole cycle left: the common case)
-        for (int k = 0; k < 3; k++) applied[k] = trial[k] = (low + rate * part) * u[k] + shrink * q[k];
+        FOR_XYZ(k) applied[k] = trial[k] = (low + rate * part) * u[k] + shrink * q[k];
         stick += rest;
         return;
       }
@@ -370,9 +378,9 @@ public:
     if (update_history) {
       if (project) {
         // stock history: increment, then project onto the current tangent plane
-        for (int k = 0; k < 3; k++) D[k] += vs[k] * dt;
+        FOR_XYZ(k) D[k] += vs[k] * dt;
         const double dn = StickSlip::dot(D, en);
-        for (int k = 0; k < 3; k++) D[k] -= dn * en[k];
+        FOR_XYZ(k) D[k] -= dn * en[k];
         // (exact timing: the step starts from D - V_s dt, the increment projected with D)
       } else {
         // 3D form: turn D into the current tangent plane, keeping its length (docs/law.md
@@ -382,7 +390,7 @@ public:
         if (dn != 0.0) {
           const double old2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
           const double x = dn * dn / old2;  // sin^2 of the angle between D and the plane
-          for (int k = 0; k < 3; k++) D[k] -= dn * en[k];
+          FOR_XYZ(k) D[k] -= dn * en[k];
           // the contact turns by less than 1e-3 rad in a step (nearly always): the series of
           // (1 - x)^(-1/2), whose first dropped term, 5x^3/16 < 4e-19, is below round-off;
           // it spares the square root on the path every contact takes (1-2 % of a step, measured)
@@ -393,15 +401,15 @@ public:
             const double new2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
             scale = new2 > 0.0 ? std::sqrt(old2 / new2) : 1.0;
           }
-          for (int k = 0; k < 3; k++) D[k] *= scale;
+          FOR_XYZ(k) D[k] *= scale;
         }
-        for (int k = 0; k < 3; k++) D[k] += vs[k] * dt;  // eq. 7
+        FOR_XYZ(k) D[k] += vs[k] * dt;  // eq. 7
       }
     }
 
     // eq. 5: trial force = spring + dashpot
     double F[3];
-    for (int k = 0; k < 3; k++) F[k] = -kt * D[k] - gammat * vs[k];
+    FOR_XYZ(k) F[k] = -kt * D[k] - gammat * vs[k];
     const double mag2 = F[0]*F[0] + F[1]*F[1] + F[2]*F[2];
     const double ms = mu_s[sidata.itype][sidata.jtype];
     const double limit = ms * fn;
@@ -435,7 +443,7 @@ public:
           // nu_s |V_s|) u less the dashpot, i.e. Fmin u (eq. 5).
           STICK_SLIP_COUNT(EXACT_E4_START);
           const double c = fmin / std::sqrt(vs2), ck = c / kt;
-          for (int k = 0; k < 3; k++) {
+          FOR_XYZ(k) {
             F[k] = -c * vs[k];
             D[k] = ck * vs[k];
           }
@@ -454,7 +462,7 @@ public:
           StickSlip::exact_slips(F0, v, limit, fmin, r, kt, gammat, dt, reset_total, flow_law, applied, trial, stuck);
           stick = stuck;
           // the spring at the end holds the trial force less the dashpot (eq. 5)
-          for (int k = 0; k < 3; k++) {
+          FOR_XYZ(k) {
             F[k] = applied[k];
             D[k] = -(trial[k] + gammat * vs[k]) / kt;
           }
@@ -465,20 +473,20 @@ public:
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) Fn along the trial force
       const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;
       const double scale = mag2 > 0.0 ? fmin / std::sqrt(mag2) : 0.0;
-      for (int k = 0; k < 3; k++) F[k] *= scale;
+      FOR_XYZ(k) F[k] *= scale;
       // eq. 8: reset the spring so that it carries Fmin (or spring + dashpot do)
-      for (int k = 0; k < 3; k++)
+      FOR_XYZ(k)
         D[k] = reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;
     }
 
     if (!exact && !slip) STICK_SLIP_COUNT(STEP_STICK);
     if (update_history) {
-      for (int k = 0; k < 3; k++) hist[k] = D[k];
+      FOR_XYZ(k) hist[k] = D[k];
       if (stamp_offset >= 0) sidata.contact_history[stamp_offset] = this_pass;
       if (record) {
         double * const rec = &sidata.contact_history[record_offset];
         rec[0] = fn;
-        for (int k = 0; k < 3; k++) rec[1 + k] = F[k];
+        FOR_XYZ(k) rec[1 + k] = F[k];
         rec[4] = (fresh ? 0.0 : rec[4]) + (slip ? 1.0 : 0.0);
       }
     }
@@ -491,12 +499,12 @@ public:
     }
     if (sidata.is_wall) {
       const double a = sidata.area_ratio;
-      for (int k = 0; k < 3; k++) {
+      FOR_XYZ(k) {
         i_forces.delta_F[k] += F[k] * a;
         i_forces.delta_torque[k] += -sidata.cri * tor[k] * a;
       }
     } else {
-      for (int k = 0; k < 3; k++) {
+      FOR_XYZ(k) {
         i_forces.delta_F[k] += F[k];
         j_forces.delta_F[k] -= F[k];
         i_forces.delta_torque[k] += -sidata.cri * tor[k];
@@ -535,7 +543,7 @@ public:
     }
     // the spring part of the applied force, and the rest (dashpot, slip)
     double Fela[3], Fdiss[3];
-    for (int k = 0; k < 3; k++) {
+    FOR_XYZ(k) {
       Fela[k] = -kt * D[k];
       Fdiss[k] = F[k] - Fela[k];
     }
@@ -544,7 +552,7 @@ public:
     const double tdis[3] = { en[1]*Fdiss[2] - en[2]*Fdiss[1], en[2]*Fdiss[0] - en[0]*Fdiss[2], en[0]*Fdiss[1] - en[1]*Fdiss[0] };
     if (elasticpot) {
       double * const ep = &sidata.contact_history[elastic_potential_offset];
-      for (int k = 0; k < 3; k++) {
+      FOR_XYZ(k) {
         ep[1 + k] -= Fela[k];
         ep[4 + k] -= -sidata.cri * tela[k];
         ep[7 + k] -= -sidata.crj * tela[k];
@@ -553,7 +561,7 @@ public:
     if (dissipated) {
       double * const di = fix_dissipated->array_atom[sidata.i];
       di[0] += 0.5 * total;
-      for (int k = 0; k < 3; k++) {
+      FOR_XYZ(k) {
         di[1 + k] += -Fdiss[k];
         di[4 + k] += sidata.cri * tdis[k];
       }
@@ -561,7 +569,7 @@ public:
       if (sidata.j < atom->nlocal) {
         double * const dj = fix_dissipated->array_atom[sidata.j];
         dj[0] += 0.5 * total;
-        for (int k = 0; k < 3; k++) {
+        FOR_XYZ(k) {
           dj[1 + k] -= -Fdiss[k];
           dj[4 + k] += sidata.crj * tdis[k];
         }
@@ -600,6 +608,8 @@ public:
 
 }
 }
+
+#undef FOR_XYZ
 
 #endif
 #endif

@@ -11,14 +11,13 @@ wall's record columns). Made with one build into OUT; compare two OUTs byte for 
     .venv/bin/python tools/lammps_speed_dumps.py BUILD_DIR OUT_DIR
     (BUILD_DIR: a folder with lmp-stickslip, e.g. build/lammps_plugin or a copy of it)
 """
-import concurrent.futures
 import re
-import subprocess
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from stickslip.adapters import lammps_bench as b  # noqa: E402
+from speed_dump_runs import run_cases  # noqa: E402
 
 if len(sys.argv) != 3:
     sys.exit(__doc__)
@@ -69,17 +68,4 @@ cases["bench-step"] = bench("mu_k 0.45 reset spring")
 cases["bench-exact"] = bench("mu_k 0.45 reset spring slip_timing exact")
 cases["bench-exact-keep"] = bench("mu_k 0.45 reset spring slip_timing exact history_rotation keep_length record yes")
 
-def run(name):
-    d = out / name; d.mkdir(exist_ok=True)
-    (d / "in.x").write_text(cases[name])
-    p = subprocess.run([exe, "-in", "in.x", "-log", "none", "-echo", "none", "-nocite"], cwd=d, env=b._env(),
-                       capture_output=True, text=True)
-    if p.returncode or "ERROR" in p.stdout:
-        return f"{name}: FAILED {p.stdout[-300:]}"
-    return f"{name}: ok, {(d / 'dump.out').stat().st_size} bytes"
-failed = 0
-with concurrent.futures.ThreadPoolExecutor(2) as pool:
-    for r in pool.map(run, cases):
-        print(r, flush=True)
-        failed += "FAILED" in r
-sys.exit(1 if failed else 0)
+run_cases(cases, out, [exe, "-log", "none", "-echo", "none", "-nocite"], b._env())
