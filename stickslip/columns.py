@@ -16,6 +16,11 @@ STATS = ("n_contacts", "ekin")
 # V* = 2(mu_s - mu_k) Fn / (nu_s + Ks dt) (docs/law.md: above them every step slips; nu_s
 # = 0: V_d is infinite), and the sum of |Fs|/Fn over those (its mean: / n_slipping).
 SLIP_STATS = ("n_slipping", "n_slip_above_vd", "n_slip_above_vstar", "slip_fs_fn_sum")
+# output.bulk: the moving grains' centre of mass and its velocity (m, m/s).
+BULK = ("com_x", "com_y", "com_z", "vcm_x", "vcm_y", "vcm_z")
+# With a gravity_ramp: the angle gravity has turned by over the interval that ends at the
+# row (rad) and the index of that interval's phase.
+RAMP = ("tilt", "phase")
 
 
 def grain(name, dim, rotation):
@@ -49,6 +54,10 @@ def names(scene):
         cols += SLIP_STATS
     if out.energy:
         cols += ENERGY
+    if out.bulk:
+        cols += BULK
+    if scene.gravity_ramp is not None:
+        cols += RAMP
     return cols
 
 

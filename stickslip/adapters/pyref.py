@@ -14,5 +14,6 @@ def available():
 
 
 def run(scene, out_dir, progress=None):
+    scene.refuse_unsupported("pyref")
     rec = Simulation(scene).run(progress=progress)
     return RunResult(columns.frame(scene, rec), rec.steps, rec.wall_time_s)

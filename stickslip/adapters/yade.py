@@ -60,6 +60,7 @@ def scene_dict(scene):
 
 
 def run(scene, out_dir, progress=None):
+    scene.refuse_unsupported("YADE")
     if scene.contact.law != "stick_slip":
         raise ValueError(f"the YADE law implements stick_slip only, not {scene.contact.law}")
     if scene.output.energy:

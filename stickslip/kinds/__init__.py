@@ -3,7 +3,8 @@
 A kind module provides (the contract; report, precision and analysis only loop):
 - NAME, and NAMES: the `[analysis]` keys it needs, each with its rule ("grain": a
   recorded grain, "contact": a recorded contact, "wall": a wall, "turning wall": a
-  turning wall whose angle is recorded, "seconds": a time >= 0), checked when the scene is loaded;
+  turning wall whose angle is recorded, "seconds": a time >= 0, "phase": the index of a
+  gravity_ramp phase), checked when the scene is loaded;
 - summarise(scene, df) -> dict: the headline figures of a run (summary.json);
 - errors(scene, summary, df, ref_summary, ref_df) -> dict: relative error measures of a
   run against a converged reference run (`stickslip precision`);
@@ -20,9 +21,9 @@ A kind module provides (the contract; report, precision and analysis only loop):
 from __future__ import annotations
 
 from ..errors import SceneError
-from . import drag, drum, none, tilt, tray
+from . import drag, drum, heap3d, incline3d, none, tilt, tray
 
-KINDS = {k.NAME: k for k in (none, drag, tray, tilt, drum)}
+KINDS = {k.NAME: k for k in (none, drag, tray, tilt, drum, incline3d, heap3d)}
 
 
 def get(name):
@@ -32,7 +33,7 @@ def get(name):
         raise SceneError(f"analysis.kind = {name!r}: must be one of {', '.join(KINDS)}") from None
 
 
-def read_names(table, kind, grains, walls, output) -> dict:
+def read_names(table, kind, grains, walls, output, ramp=None) -> dict:
     """The kind's `[analysis]` names, each checked against the scene (table: the reader's
     `[analysis]` table, which then refuses any key the kind does not know)."""
     grain_names = {g.name for g in grains}
@@ -56,6 +57,11 @@ def read_names(table, kind, grains, walls, output) -> dict:
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 <= v <= 1e100:
                 raise SceneError(f"{where} = {v!r}: must be a time in seconds, >= 0")
             v = float(v)
+        elif rule == "phase":
+            n = len(ramp.phases) if ramp is not None else 0
+            if isinstance(v, bool) or not isinstance(v, int) or not 0 <= v < n:
+                raise SceneError(f"{where} = {v!r}: must be the index of a gravity_ramp.phase (0 to {n - 1})"
+                                 if n else f"{where}: needs a [gravity_ramp] with phases")
         elif rule == "turning wall":
             if not isinstance(v, str) or v not in turning:
                 raise SceneError(f"{where} = {v!r}: must be a turning wall (with a rotation)")

@@ -32,6 +32,10 @@ class Contact:
     mu_k: float
     reset: str = "spring"
     slip_timing: str = "step"  # step (the paper, literally) | exact (docs/law.md)
+    # rolling resistance: "" (none) or "epsd2" (LIGGGHTS' elastic-plastic spring-dashpot
+    # model: a torque opposing the relative rolling, capped at rolling_mu * R * Fn)
+    rolling: str = ""
+    rolling_mu: float = 0.0
 
     def law_params(self, effects) -> LawParams:
         """The kernel's parameters with the scene's effects applied (damping off = 0)."""
@@ -82,6 +86,28 @@ class Output:
     # slip statistics of the grain-grain contacts at each row (columns.SLIP_STATS)
     slip_stats: bool = False
     energy: bool = False  # energy columns (docs/adapters.md); engines that cannot give them refuse
+    # the moving grains' centre of mass and its velocity (columns.BULK)
+    bulk: bool = False
+
+
+@dataclass
+class RampPhase:
+    """One phase of a gravity ramp: gravity turns at `rate` (rad/s, signed) until `until`
+    holds: "duration" (for `value` s), "speed_above" or "speed_below" (the moving grains'
+    mean velocity along the ramp's downhill direction passes `value`, m/s)."""
+    rate: float
+    until: str
+    value: float
+
+
+@dataclass
+class GravityRamp:
+    """3D gravity turned about `axis` (unit) through phases (a tilting incline). The angle
+    and the conditions change only at the recorded rows (every output.every steps): over
+    each interval the angle is held, then it moves by rate * every * dt for the next one."""
+    axis: np.ndarray
+    phases: list
+    max_angle: float  # rad: the run ends if the angle leaves [0, max_angle]
 
 
 @dataclass
@@ -106,6 +132,9 @@ class Scene:
     # (rate, duration): gravity turns at this rate first, for this long, then at
     # gravity_rate (a drum brought quickly to its avalanche angle, then turned slowly)
     gravity_spinup: tuple = (0.0, 0.0)
+    # 3D: axis -> (lo, hi) of the periodic box along x and/or y (grains leaving at hi come back at lo)
+    periodic: dict = field(default_factory=dict)
+    gravity_ramp: GravityRamp | None = None
 
     def gravity_angle(self, t) -> float:
         """The angle gravity has turned by at time t, rad."""
@@ -120,6 +149,39 @@ class Scene:
         c, s = math.cos(a), math.sin(a)
         g = self.gravity
         return np.array([c * g[0] - s * g[1], s * g[0] + c * g[1], g[2]])
+
+    def downhill(self) -> np.ndarray:
+        """The ramp's downhill direction: where gravity turns to, axis x initial gravity (unit)."""
+        u = np.cross(self.gravity_ramp.axis, self.gravity)
+        return u / np.linalg.norm(u)
+
+    def gravity_tilted(self, angle) -> np.ndarray:
+        """The scene's gravity turned by `angle` (rad) about the ramp's axis (Rodrigues)."""
+        k, g = self.gravity_ramp.axis, self.gravity
+        c, s = math.cos(angle), math.sin(angle)
+        return g * c + np.cross(k, g) * s + k * float(k @ g) * (1 - c)
+
+    def features(self) -> dict:
+        """The features of this scene that not every engine has: {key: what it is, in words}."""
+        out = {}
+        if self.periodic:
+            out["periodic"] = f"periodic boundaries (periodic: {', '.join(self.periodic)})"
+        if self.gravity_ramp is not None:
+            out["gravity_ramp"] = "a gravity ramp with conditions (gravity_ramp)"
+        if self.contact.rolling:
+            out["rolling"] = f"rolling resistance (contact.rolling = {self.contact.rolling!r})"
+        if self.output.bulk:
+            out["bulk"] = "the bulk columns (output.bulk)"
+        return out
+
+    def refuse_unsupported(self, engine, supported=()):
+        """One line (ValueError) if the scene needs a feature the engine lacks, never a silent run."""
+        missing = [text for key, text in self.features().items() if key not in supported]
+        if missing:
+            raise ValueError(f"{engine} cannot run scene {self.name}: it has no {'; no '.join(missing)}")
+
+    def moving_grains(self) -> list:
+        return [g for g in self.grains if not g.fixed]
 
     @property
     def steps(self) -> int:

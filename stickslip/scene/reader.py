@@ -18,7 +18,7 @@ from pyref.laws import LAWS, RESETS, SLIP_TIMINGS, LawParams
 
 from .. import columns, kinds
 from ..errors import SceneError
-from .model import Contact, Grain, Output, Scene, Wall, WallRotation, mass
+from .model import Contact, GravityRamp, Grain, Output, RampPhase, Scene, Wall, WallRotation, mass
 from .stability import stability_limits
 
 CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
@@ -67,10 +67,19 @@ MAX_GRAVITY_RATE = 2 * math.pi
 # diameter, jittered inside the slack, so that they do not touch at the start.
 FILL_SLACK = 1.1
 
+# Rolling resistance models (contact.rolling): LIGGGHTS' epsd2 only (no other engine here has one).
+ROLLING_MODELS = ("epsd2",)
+# gravity_ramp: a phase ends on one of these conditions (RampPhase.until).
+RAMP_CONDITIONS = ("duration", "speed_above", "speed_below")
+# [[base]]: at most this many spheres (the relaxation that spreads them is quadratic in them).
+MAX_BASE_SPHERES = 5000
+# [[base]]: spheres are pushed apart until no two overlap by more than this share of a diameter.
+BASE_OVERLAP = 1e-6
+
 # Overrides by name -> (table, key) in the scene file.
 _OVERRIDES = {"dt": ("time", "dt"), "duration": ("time", "duration"), "every": ("output", "every"),
               **{k: ("contact", k) for k in ("law", "kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k", "reset",
-                                             "slip_timing")},
+                                             "slip_timing", "rolling", "rolling_mu")},
               **{f"effect_{e}": ("effects", e) for e in EFFECTS}}
 
 
@@ -152,6 +161,9 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
         if not gravity_rate:
             raise SceneError("gravity_spinup: goes with a turning gravity (set gravity_rate)")
 
+    periodic = _periodic(top, dim)
+    ramp = _gravity_ramp(top, dim, effects, gravity, gravity_rate)
+
     contact = _contact(_Table(top.get("contact", required=True), "contact"))
 
     tt = _Table(top.get("time", required=True), "time")
@@ -172,8 +184,12 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
     fills = [_Table(b, f"fill[{i}]") for i, b in enumerate(top.array("fill"))]
     if (rings or fills) and dim != 2:
         raise SceneError(f"{'ring' if rings else 'fill'}: rings and fills are made in 2D scenes only (dimension = 2)")
+    bases = [_Table(b, f"base[{i}]") for i, b in enumerate(top.array("base"))]
+    if bases and dim != 3:
+        raise SceneError("base: a rough base of spheres is made in 3D scenes only (dimension = 3)")
+    base_counts = [_base_count(t, periodic) for t in bases]
     n_grains = (len(grain_tables) + sum(math.prod(c) for c in counts)
-                + sum(_count(t) for t in rings) + sum(_count(t) for t in fills))
+                + sum(_count(t) for t in rings) + sum(_count(t) for t in fills) + sum(base_counts))
     if n_grains > MAX_GRAINS:
         raise SceneError(f"grain, lattice[].counts: {n_grains:.3g} grains; at most {MAX_GRAINS:.0e} per scene "
                          f"(the scene alone would need ~{n_grains * 0.9e3 / 1e9:.0f} GB)")
@@ -201,6 +217,8 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
         grains.extend(_ring(rt))
     for ft in fills:
         grains.extend(_fill(ft))
+    for bt, n in zip(bases, base_counts):
+        grains.extend(_base(bt, n, periodic))
     if not grains:
         raise SceneError("grain: a scene needs at least one [[grain]] or [[lattice]]")
     _unique([g.name for g in grains], "grain.name")
@@ -231,17 +249,25 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
                 raise SceneError(f"wall[{i}].rotation.rate = {r.rate:g} rad/s: at dt = {dt:g} s it reaches "
                                  f"stop_angle = {r.stop_angle:g} rad after {turn:.3g} steps; at most {MAX_STEPS:.0e}")
     _unique([g.name for g in grains] + [w.name for w in walls], "grain/wall name")
-    _check_start(grains, walls, dim)
+    _check_periodic(periodic, grains, walls)
+    _check_start(grains, walls, dim, periodic)
 
     output = _output(_Table(top.get("output", {}), "output"), grains, walls)
     at = _Table(top.get("analysis", {"kind": "none"}), "analysis")
     kind = kinds.get(at.string("kind", "none", tuple(kinds.KINDS)))
-    analysis = {"kind": kind.NAME, **kinds.read_names(at, kind, grains, walls, output)}
+    analysis = {"kind": kind.NAME, **kinds.read_names(at, kind, grains, walls, output, ramp)}
     at.done()
     top.done()
 
     scene = Scene(name, description, dim, effects, gravity, contact, dt, duration,
-                  grains, walls, output, analysis, source, gravity_rate, spinup)
+                  grains, walls, output, analysis, source, gravity_rate, spinup, periodic, ramp)
+    if contact.rolling and not effects["rotation"]:
+        raise SceneError(f"contact.rolling = {contact.rolling!r}: rolling resistance acts on spins; set "
+                         "effects.rotation = true")
+    if output.bulk and not scene.moving_grains():
+        raise SceneError("output.bulk: the scene has no moving grain (every grain is fixed)")
+    if ramp is not None and not scene.moving_grains():
+        raise SceneError("gravity_ramp: its conditions follow the moving grains, and every grain is fixed")
     limits = stability_limits(scene)
     cause = min(limits, key=limits.get)
     if dt > limits[cause]:
@@ -283,9 +309,17 @@ def _contact(ct) -> Contact:
         mu_k=ct.number("mu_k", required=True),
         reset=ct.string("reset", "spring", RESETS),
         slip_timing=ct.string("slip_timing", "step", SLIP_TIMINGS),
+        rolling=ct.string("rolling", "", ("",) + ROLLING_MODELS),
+        rolling_mu=ct.number("rolling_mu", 0.0, lo=0, hi=1),
     )
     ct.done()
     check_contact(contact)
+    if contact.rolling and contact.rolling_mu <= 0:
+        raise SceneError(f"contact.rolling_mu = {contact.rolling_mu:g}: must be > 0 with contact.rolling = "
+                         f"{contact.rolling!r} (or leave contact.rolling out)")
+    if contact.rolling_mu and not contact.rolling:
+        raise SceneError(f"contact.rolling_mu = {contact.rolling_mu:g}: needs a rolling model "
+                         f"(contact.rolling = {' or '.join(map(repr, ROLLING_MODELS))})")
     return contact
 
 
@@ -308,6 +342,7 @@ def _output(ot, grains, walls) -> Output:
         stats=ot.boolean("stats", False),
         slip_stats=ot.boolean("slip_stats", False),
         energy=ot.boolean("energy", False),
+        bulk=ot.boolean("bulk", False),
     )
     ot.done()
     seen = set()
@@ -321,10 +356,12 @@ def _output(ot, grains, walls) -> Output:
     return output
 
 
-def _check_start(grains, walls, dim):
-    """Refuse starting states the engines cannot agree on (MAX_START_OVERLAP)."""
+def _check_start(grains, walls, dim, periodic=None):
+    """Refuse starting states the engines cannot agree on (MAX_START_OVERLAP); across a
+    periodic boundary too."""
     x = np.array([g.position for g in grains])
     r = np.array([g.radius for g in grains])
+
     for w in walls:
         dist = (x - w.point) @ w.normal
         for i in np.flatnonzero(dist <= (1 - MAX_START_OVERLAP) * r):
@@ -332,13 +369,36 @@ def _check_start(grains, walls, dim):
             raise SceneError(f"grain {grains[i].name!r} starts {where} wall {w.name!r} (centre {dist[i]:.3g} m "
                              f"from it, radius {r[i]:.3g} m): a grain may start overlapping a wall by at most "
                              f"{MAX_START_OVERLAP:g} of its radius")
-    a, b = _near_pairs(x[:, :dim], r)
-    gap = np.linalg.norm(x[a] - x[b], axis=1) - (r[a] + r[b])
+    if periodic:
+        a, b, dist = _near_pairs_periodic(x, r, periodic)
+    else:
+        a, b = _near_pairs(x[:, :dim], r)
+        dist = np.linalg.norm(x[a] - x[b], axis=1)
+    gap = dist - (r[a] + r[b])
     bad = np.flatnonzero(gap < -MAX_START_OVERLAP * np.minimum(r[a], r[b]))
     if len(bad):
         i, j = a[bad[0]], b[bad[0]]
         raise SceneError(f"grains {grains[i].name!r} and {grains[j].name!r} start overlapping by "
                          f"{-gap[bad[0]]:.3g} m: at most {MAX_START_OVERLAP:g} of the smaller radius")
+
+
+def _near_pairs_periodic(x, r, periodic):
+    """(a, b, distance) of every pair of grains closer than twice the largest radius, the
+    distance to the nearest periodic image (x, y periodic as the scene says)."""
+    from scipy.spatial import cKDTree
+
+    span = np.ptp(x, axis=0) + 4 * r.max() + 1.0
+    box, y = np.empty(3), np.array(x, float)
+    for k, axis in enumerate("xyz"):
+        if axis in periodic:
+            lo, hi = periodic[axis]
+            box[k], y[:, k] = hi - lo, (x[:, k] - lo) % (hi - lo)
+        else:  # not periodic: a box far wider than the grains' spread never wraps
+            box[k], y[:, k] = 2 * span[k], x[:, k] - x[:, k].min()
+    p = cKDTree(y, boxsize=box).query_pairs(2 * r.max(), output_type="ndarray")
+    d = y[p[:, 0]] - y[p[:, 1]]
+    d -= box * np.round(d / box)
+    return p[:, 0], p[:, 1], np.linalg.norm(d, axis=1)
 
 
 def _near_pairs(x, r):
@@ -665,3 +725,166 @@ def _fill(ft: _Table):
     pos[:, :2] = center[:2] + xy[order] + 0.5 * (s - 2 * rmax) * u[:, :2] / math.sqrt(2)
     radii = r * (1 + spread * u[:, 2])
     return [Grain(f"{prefix}{k}", float(radii[k]), density, pos[k], np.zeros(3)) for k in range(n)]
+
+
+def _periodic(top: _Table, dim):
+    """[periodic]: axis -> (lo, hi), x and/or y, 3D only."""
+    if "periodic" not in top.data:
+        return {}
+    pt = _Table(top.get("periodic"), "periodic")
+    if dim != 3:
+        raise SceneError("periodic: periodic boundaries are for 3D scenes (dimension = 3)")
+    out = {}
+    for axis in ("x", "y"):
+        v = pt.get(axis)
+        if v is None:
+            continue
+        if (not isinstance(v, list) or len(v) != 2 or not all(isinstance(a, (int, float)) and not isinstance(a, bool)
+                                                              and _finite(a) for a in v) or not v[0] < v[1]):
+            raise SceneError(f"{pt.key(axis)}: expected [lo, hi] with lo < hi (the periodic box along {axis}), "
+                             f"got {_shown(v)}")
+        out[axis] = (float(v[0]), float(v[1]))
+    pt.done()
+    if not out:
+        raise SceneError("periodic: give x = [lo, hi] and/or y = [lo, hi]")
+    return out
+
+
+def _check_periodic(periodic, grains, walls):
+    """Grains inside the periodic box, no wall across a periodic axis, and a box wide enough
+    that no grain touches its own image."""
+    if not periodic:
+        return
+    x = np.array([g.position for g in grains])
+    r = np.array([g.radius for g in grains])
+    for axis, (lo, hi) in periodic.items():
+        k = "xyz".index(axis)
+        out = np.flatnonzero((x[:, k] < lo) | (x[:, k] >= hi))
+        if len(out):
+            g = grains[out[0]]
+            raise SceneError(f"grain {g.name!r} starts at {axis} = {g.position[k]:.6g}, outside the periodic box "
+                             f"periodic.{axis} = [{lo:g}, {hi:g})")
+        if hi - lo <= 4 * r.max():
+            raise SceneError(f"periodic.{axis} = [{lo:g}, {hi:g}]: must be longer than two largest diameters "
+                             f"({4 * r.max():.3g} m): a grain would touch its own image")
+        for w in walls:
+            if abs(w.normal[k]) > 1e-12:
+                raise SceneError(f"wall {w.name!r}: its normal has a part along the periodic axis {axis} (a plane "
+                                 "across a periodic box would cut it)")
+
+
+def _gravity_ramp(top: _Table, dim, effects, gravity, gravity_rate):
+    """[gravity_ramp]: 3D gravity turned about an axis through phases (docs/scene-format.md)."""
+    if "gravity_ramp" not in top.data:
+        return None
+    rt = _Table(top.get("gravity_ramp"), "gravity_ramp")
+    if dim != 3:
+        raise SceneError("gravity_ramp: for 3D scenes (dimension = 3); 2D scenes turn gravity with gravity_rate")
+    if not (effects["gravity"] and np.any(gravity)):
+        raise SceneError("gravity_ramp: needs effects.gravity = true and a non-zero gravity")
+    if gravity_rate:
+        raise SceneError("gravity_ramp: not with gravity_rate (one way of turning gravity per scene)")
+    axis = rt.vector("axis", 3, required=True)
+    g = gravity / np.linalg.norm(gravity)
+    if np.linalg.norm(axis) == 0 or abs(float(axis @ g)) > 1e-9 * np.linalg.norm(axis):
+        raise SceneError(f"gravity_ramp.axis = {_shown(list(axis))}: must be a non-zero vector perpendicular to "
+                         "gravity (gravity turns about it)")
+    max_angle = rt.number("max_angle", 90.0, lo=0, lo_open=True, hi=180.0)
+    phases = []
+    for i, ph in enumerate(rt.array("phase")):
+        pt = _Table(ph, f"gravity_ramp.phase[{i}]")
+        rate = pt.number("rate", required=True, lo=-MAX_GRAVITY_RATE * 180 / math.pi, hi=MAX_GRAVITY_RATE * 180 / math.pi)
+        given = [c for c in RAMP_CONDITIONS if c in pt.data]
+        if len(given) != 1:
+            raise SceneError(f"gravity_ramp.phase[{i}]: give exactly one of {', '.join(RAMP_CONDITIONS)} (how the "
+                             f"phase ends), got {', '.join(given) or 'none'}")
+        value = pt.number(given[0], required=True, lo=0, lo_open=True)
+        pt.done()
+        phases.append(RampPhase(math.radians(rate), given[0], value))
+    rt.done()
+    if not phases:
+        raise SceneError("gravity_ramp.phase: at least one [[gravity_ramp.phase]]")
+    return GravityRamp(axis / np.linalg.norm(axis), phases, math.radians(max_angle))
+
+
+def _base_extent(bt: _Table, periodic):
+    """A base's lower corner and its x, y size: the periodic box along a periodic axis
+    unless given."""
+    origin = bt.vector("origin", 3, required=True)
+    size = bt.get("size")
+    if size is None:
+        if set(periodic) != {"x", "y"}:
+            raise SceneError(f"{bt.key('size')}: missing (required unless the scene is periodic in x and y)")
+        size = [periodic["x"][1] - periodic["x"][0], periodic["y"][1] - periodic["y"][0]]
+    if (not isinstance(size, list) or len(size) != 2
+            or not all(isinstance(a, (int, float)) and not isinstance(a, bool) and _finite(a) and a > 0 for a in size)):
+        raise SceneError(f"{bt.key('size')}: expected 2 positive numbers (x and y extent), got {_shown(size)}")
+    return origin, [float(a) for a in size]
+
+
+def _base_count(bt: _Table, periodic):
+    """How many spheres a base holds, read before any grain is made (the size check)."""
+    origin, size = _base_extent(bt, periodic)
+    per_area = bt.number("number_density", required=True, lo=0, lo_open=True)
+    radius = bt.number("radius", required=True, lo=0, lo_open=True)
+    n = int(round(per_area * size[0] * size[1]))
+    most = 1.0 / (2 * math.sqrt(3) * radius**2)  # hexagonal close packing of the plane
+    thickness = bt.number("thickness", 0.0, lo=0)
+    layers = 1 + thickness / (2 * radius)
+    if per_area > 0.7 * most * layers:
+        raise SceneError(f"{bt.key('number_density')} = {per_area:g}: at most {0.7 * most * layers:.3g} spheres per "
+                         f"unit area fit loosely in a layer {thickness:g} m thick (radius {radius:g} m)")
+    if not 1 <= n <= MAX_BASE_SPHERES:
+        raise SceneError(f"{bt.key('number_density')} = {per_area:g}: {n} spheres on {size[0]:g} x {size[1]:g} m; "
+                         f"must be 1 to {MAX_BASE_SPHERES}")
+    return n
+
+
+def _base(bt: _Table, n, periodic):
+    """A rough base: n fixed spheres at random in the slab origin + [0, size] x [0, thickness]
+    (z), pushed apart until none overlap (a slice of a random packing, as the rough base of
+    Silbert et al. 2001); across the box's periodic boundaries where the base spans them."""
+    origin, size = _base_extent(bt, periodic)
+    radius = bt.number("radius", required=True, lo=0, lo_open=True)
+    thickness = bt.number("thickness", 0.0, lo=0)
+    density = bt.number("density", required=True, lo=0, lo_open=True)
+    seed = bt.integer("seed", 0, lo=0)
+    prefix = bt.string("prefix", "base")
+    bt.number("number_density", required=True)
+    bt.done()
+    _check_mass(bt.where, 3, radius, radius, density)
+    wrap = np.array([axis in periodic and math.isclose(size[k], periodic[axis][1] - periodic[axis][0])
+                     and math.isclose(origin[k], periodic[axis][0]) for k, axis in enumerate("xy")])
+    pos = relaxed_slab(n, np.array(size), thickness, 2 * radius, wrap, np.random.default_rng(seed))
+    pos += origin
+    return [Grain(f"{prefix}{k}", radius, density, pos[k], np.zeros(3), fixed=True) for k in range(n)]
+
+
+def relaxed_slab(n, size, thickness, diameter, wrap, rng, iterations=20000):
+    """n points uniform in [0, size] x [0, thickness], then each overlapping pair (closer
+    than `diameter`) pushed apart by half its overlap each, until none overlaps by more than
+    BASE_OVERLAP of a diameter; x, y wrap where `wrap` says (periodic), else stay in range."""
+    from scipy.spatial import cKDTree
+
+    p = np.column_stack([rng.uniform(0, size[0], n), rng.uniform(0, size[1], n), rng.uniform(0, thickness, n)])
+    # cKDTree wraps every axis of its box: an axis that must not wrap gets a box twice its range
+    box = np.array([size[0] if wrap[0] else 2 * size[0] + 2 * diameter,
+                    size[1] if wrap[1] else 2 * size[1] + 2 * diameter, 2 * thickness + 2 * diameter])
+    for _ in range(iterations):
+        pairs = cKDTree(p, boxsize=box).query_pairs(diameter * (1 - BASE_OVERLAP), output_type="ndarray")
+        if not len(pairs):
+            return p
+        a, b = pairs[:, 0], pairs[:, 1]
+        d = p[a] - p[b]
+        d -= box * np.round(d / box)
+        dist = np.linalg.norm(d, axis=1)
+        push = (0.5 * (diameter - dist) / np.maximum(dist, 1e-300))[:, None] * d
+        move = np.zeros_like(p)
+        np.add.at(move, a, push)
+        np.add.at(move, b, -push)
+        p += move
+        for k in range(2):
+            p[:, k] = p[:, k] % size[k] if wrap[k] else np.clip(p[:, k], 0, size[k])
+        p[:, 2] = np.clip(p[:, 2], 0, thickness)
+    raise SceneError(f"base: {n} spheres could not be spread without overlaps in {size[0]:g} x {size[1]:g} x "
+                     f"{thickness:g} m; lower number_density")
