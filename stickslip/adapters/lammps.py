@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from . import RunResult
+from .ramp_script import bulk_dump, bulk_variables, ramp_loop, ramp_setup
 from .text_dumps import id_ranges, read_dump, timeseries
 
 NAME = "lammps"
@@ -98,6 +99,8 @@ class _Script:
         lo, hi = pts.min(axis=0) - margin, pts.max(axis=0) + margin
         if sc.dimension == 2:
             lo[2], hi[2] = -margin, margin  # z is periodic and inert in 2D
+        for axis, (a, b) in sc.periodic.items():  # the periodic box is the scene's own
+            lo["xyz".index(axis)], hi["xyz".index(axis)] = a, b
         return lo, hi
 
     def _data_file(self, lo, hi):
@@ -135,7 +138,8 @@ class _Script:
             self.add("dimension 2")
         # atoms are not sorted in memory: the neighbour lists keep one order through the run
         self.add("atom_style sphere", "atom_modify map array sort 0 0.0", "comm_modify vel yes",
-                 "boundary f f p" if d2 else "boundary f f f", f"read_data {self._data_file(lo, hi)}")
+                 "boundary " + ("f f p" if d2 else " ".join("p" if a in sc.periodic else "f" for a in "xyz")),
+                 f"read_data {self._data_file(lo, hi)}")
         for g in sc.grains:
             self.add(f"set atom {self.ids[g.name]} mass {_fmt(sc.grain_mass(g))}")
         rmax = max(g.radius for g in sc.grains)
@@ -155,6 +159,7 @@ class _Script:
             self.add("group fixed id " + id_ranges(fixed), "group moving subtract all fixed",
                      "neigh_modify exclude group fixed fixed")
             moving = "moving"
+        self.moving = moving
         if eff["rotation"]:
             # a disk's inertia m r^2/2 in 2D (LAMMPS' default is a sphere's, 2/5)
             self.add(f"fix integrate {moving} nve/sphere" + (" disc" if d2 else ""))
@@ -215,7 +220,9 @@ class _Script:
         gn = float(np.linalg.norm(g))
         if gn == 0:
             return
-        if sc.gravity_rate or sc.gravity_spinup[1]:
+        if sc.gravity_ramp is not None:
+            self.add(*ramp_setup(sc))
+        elif sc.gravity_rate or sc.gravity_spinup[1]:
             # turning gravity (Scene.gravity_at) as one angle, fix gravity's `spherical` style:
             # it evaluates the variable at every step, `step` being the step whose positions
             # it acts on (the arithmetic of stickslip/adapters/liggghts.py).
@@ -274,8 +281,12 @@ class _Script:
                      f"+(step%{every}!={every - 1})*((floor(step/{every})+1)*{every}-1)",
                      f"dump slips all local {every} slips.dump {local.format('slips')}",
                      "dump_modify slips every v_slipnext", _full_precision("slips"))
-        self.add(f"thermo {max(1, sc.steps // 50)}", "thermo_style custom step atoms",
-                 "thermo_modify norm no", f"run {sc.steps}")
+        if sc.output.bulk or sc.gravity_ramp is not None:
+            lines, _ = bulk_dump(sc, "bk_one", every)
+            self.add(*bulk_variables(sc, self.moving), "group bk_one id 1", *lines, _full_precision("bulk"))
+        self.add(f"thermo {max(1, sc.steps // 50)}", "thermo_style custom step atoms", "thermo_modify norm no")
+        # a ramp's run ends on its conditions: a loop of intervals (ramp_script.py)
+        self.add(*(ramp_loop(sc) if sc.gravity_ramp is not None else [f"run {sc.steps}"]))
 
     def _stats_output(self, every):
         """[output] stats, reduced in LAMMPS: contacts touching (grain pairs that overlap,
@@ -327,6 +338,7 @@ def _timeseries(script, work):
 
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
+    scene.refuse_unsupported("LAMMPS", ("periodic", "gravity_ramp", "bulk"))
     if scene.contact.law != "stick_slip":
         raise ValueError(f"the LAMMPS plugin implements stick_slip only, not {scene.contact.law}")
     if scene.output.energy:
@@ -365,4 +377,5 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     if p.returncode != 0 or not loop:
         raise RuntimeError(f"LAMMPS failed (exit {p.returncode}); see {work / 'screen.txt'}")
     df = _timeseries(script, work)
-    return RunResult(df, scene.steps, sum(loop), notes=script.notes)
+    steps = int(round(df["t"].iloc[-1] / scene.dt))  # a gravity ramp may end the run before time.duration
+    return RunResult(df, steps, sum(loop), notes=script.notes)

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from . import RunResult
+from .ramp_script import bulk_dump, bulk_variables, ramp_loop, ramp_setup
 from .text_dumps import full_precision as _full_precision, id_ranges as _id_ranges, read_dump as _read_dump
 from .text_dumps import timeseries
 
@@ -80,6 +81,8 @@ class _Script:
             # z is periodic and inert in 2D, but as thick as the plane: LIGGGHTS bins mesh
             # walls in 3D and needs a bin on either side of the grains
             lo[2], hi[2] = -margin, margin
+        for axis, (a, b) in sc.periodic.items():  # the periodic box is the scene's own
+            lo["xyz".index(axis)], hi["xyz".index(axis)] = a, b
         return lo, hi, margin
 
     def _material(self):
@@ -88,9 +91,12 @@ class _Script:
                  "gamman_abs": c.nu_n if eff["normal_damping"] else 0.0,
                  "gammat_abs": c.nu_s if eff["tangential_damping"] else 0.0,
                  "coefficientFriction": c.mu_s, "coefficientKineticFriction": c.mu_k}
+        model = "model hooke/stiffness tangential stick_slip"
+        if c.rolling:  # LIGGGHTS' own rolling model: torque capped at coefficientRollingFriction R Fn
+            props["coefficientRollingFriction"] = c.rolling_mu
+            model += f" rolling_friction {c.rolling}"
         for k, (name, value) in enumerate(props.items()):
             self.add(f"fix m{k} all property/global {name} peratomtypepair 1 {_fmt(value)}")
-        model = "model hooke/stiffness tangential stick_slip"
         settings = "absolute_damping on limitForce on stick_slip_record on"
         if c.reset == "total":
             settings += " slip_reset_total on"
@@ -146,7 +152,8 @@ class _Script:
                  "communicate single vel yes")
         if d2:
             self.add("dimension 2")
-        self.add("boundary f f p" if d2 else "boundary f f f", f"read_data {self._data_file(lo, hi)}")
+        boundary = "f f p" if d2 else " ".join("p" if a in sc.periodic else "f" for a in "xyz")
+        self.add(f"boundary {boundary}", f"read_data {self._data_file(lo, hi)}")
         rmax = max(g.radius for g in sc.grains)
         self.add(f"neighbor {_fmt(0.2 * rmax)} bin", "neigh_modify delay 0")
         model, settings = self._material()
@@ -181,7 +188,9 @@ class _Script:
         if eff["gravity"]:
             g = np.asarray(sc.gravity, float)
             gn = float(np.linalg.norm(g))
-            if gn > 0 and sc.gravity_rate:
+            if sc.gravity_ramp is not None:
+                self.add(*ramp_setup(sc))
+            elif gn > 0 and sc.gravity_rate:
                 # turning gravity (Scene.gravity_at) as one angle, the `spherical` style: fix
                 # gravity evaluates its variables at every step (`step` being the step whose
                 # positions it acts on), parsing each formula anew, so one short formula costs
@@ -208,6 +217,7 @@ class _Script:
             self.add("group fixed id " + _id_ranges(fixed), "group moving subtract all fixed",
                      "neigh_modify exclude group fixed fixed")
             moving = "moving"
+        self.moving = moving
         self.add(f"fix integrate {moving} nve/sphere" if eff["rotation"] else f"fix integrate {moving} nve")
         for g in sc.grains:
             if g.imposed:
@@ -269,8 +279,13 @@ class _Script:
                      f"+(step%{every}!={every - 1})*((floor(step/{every})+1)*{every}-1)",
                      f"dump slips all local {every} slips.dump {local.format('slips')}",
                      "dump_modify slips every v_slipnext", _full_precision("slips", 8))
-        self.add(f"thermo {max(1, sc.steps // 50)}", "thermo_style custom step atoms",
-                 "thermo_modify norm no", f"run {sc.steps}")
+        if sc.output.bulk or sc.gravity_ramp is not None:
+            lines, ncols = bulk_dump(sc, "bk_one", every)
+            self.add(*bulk_variables(sc, self.moving), "group bk_one id 1", *lines,
+                     _full_precision("bulk", ncols, ints=1))
+        self.add(f"thermo {max(1, sc.steps // 50)}", "thermo_style custom step atoms", "thermo_modify norm no")
+        # a ramp's run ends on its conditions: a loop of intervals (ramp_script.py)
+        self.add(*(ramp_loop(sc) if sc.gravity_ramp is not None else [f"run {sc.steps}"]))
 
     def _stats_output(self, every):
         """[output] stats, reduced in LIGGGHTS: contacts touching (grain pairs that overlap,
@@ -339,6 +354,7 @@ def _timeseries(script, work):
 
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
+    scene.refuse_unsupported("LIGGGHTS", ("periodic", "gravity_ramp", "rolling", "bulk"))
     if scene.contact.law != "stick_slip":
         raise ValueError(f"the LIGGGHTS plugin implements stick_slip only, not {scene.contact.law}")
     if scene.output.energy:
@@ -380,4 +396,5 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     if p.returncode != 0 or not loop:
         raise RuntimeError(f"LIGGGHTS failed (exit {p.returncode}); see {work / 'screen.txt'}")
     df = _timeseries(script, work)
-    return RunResult(df, scene.steps, sum(loop) if loop else time.perf_counter() - t0)
+    steps = int(round(df["t"].iloc[-1] / scene.dt))  # a gravity ramp may end the run before time.duration
+    return RunResult(df, steps, sum(loop) if loop else time.perf_counter() - t0)

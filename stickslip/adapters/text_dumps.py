@@ -158,6 +158,16 @@ def timeseries(engine, script, work, contact_record, slip_fn_col):
     if sc.output.slip_stats:
         cols.update(zip(columns.SLIP_STATS,
                         slip_stats(script, atoms, read_dump(work / "slips.dump"), steps, fn_col=slip_fn_col)))
+    if sc.output.bulk or sc.gravity_ramp is not None:
+        # bulk.dump (ramp_script.bulk_dump): id, then tilt and phase (a ramp), then BULK
+        bulk = read_dump(work / "bulk.dump")
+        names = (list(columns.RAMP) if sc.gravity_ramp is not None else []) + (
+            list(columns.BULK) if sc.output.bulk else [])
+        values = np.array([bulk[s][0][1:1 + len(names)] for s in steps]).reshape(len(steps), len(names))
+        got = dict(zip(names, values.T))
+        for name in columns.BULK + columns.RAMP:  # in columns.names' order
+            if name in got:
+                cols[name] = np.rint(got[name]).astype(int) if name == "phase" else got[name]
     df = pd.DataFrame(cols)
     bad = ~np.isfinite(df.to_numpy(dtype=float))
     if bad.any():
