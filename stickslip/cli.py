@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from . import scene as scene_mod
-from .adapters import ENGINES
+from .adapters import ENGINES, OPTIONAL_ENGINES
 from .errors import EngineError, SceneError
 
 
@@ -61,7 +61,7 @@ def build_parser():
 
     r = sub.add_parser("run", help="run one scene on one engine")
     r.add_argument("scene", help="a case name in cases/ (drag, tray, tilt, ...) or a path to a .toml scene")
-    r.add_argument("--engine", default="pyref", choices=ENGINES)
+    r.add_argument("--engine", default="pyref", choices=ENGINES + OPTIONAL_ENGINES)
     r.add_argument("--dt", type=_positive, help="time step, s (default: the scene's)")
     r.add_argument("--duration", type=_positive, help="simulated time, s (default: the scene's)")
     r.add_argument("--law", choices=scene_mod.LAWS, help="tangential law (default: the scene's)")
