@@ -50,8 +50,10 @@ class FakeSolver(Recorder):
             return FakeTracker(self)
         if name == "SetTimeStepSize":
             self.dt = args[0]
-        if name == "DoDynamicsThenSync":
-            self.steps += int(round(args[0] / self.dt))
+        if name == "DoDynamicsThenSync":  # (the engine's loop: while elapsed < duration, += float(dt))
+            h, elapsed = float(np.float32(self.dt)), 0.0
+            while elapsed < args[0]:
+                self.steps, elapsed = self.steps + 1, elapsed + h
         if name == "GetFamilyOwnerWildcardValue":
             return [self.record(args[0], args[1], self.steps)]
         return name
@@ -262,4 +264,5 @@ def test_time_series_from_the_record():
     assert df["grain-floor_ftx"].iloc[1] == -0.15 and df["grain-floor_fs"].iloc[1] == pytest.approx(0.15)
     assert df["grain-floor_slip"].tolist() == [0, 0, 1, 2, 0, 0, 1, 1, 0, 0, 2, 0, 2]
     assert df["t"].iloc[-1] == pytest.approx(12 * dt) and df["grain_vx"].iloc[3] == 1e-5
-    assert fake.calls("solver", "DoDynamicsThenSync") == [(dt,)] * 12
+    # one step a call: the engine steps while its float-summed time is below the duration
+    assert fake.calls("solver", "DoDynamicsThenSync") == [(0.5 * dt,)] * 12

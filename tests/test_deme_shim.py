@@ -196,3 +196,44 @@ def test_turning_wall_velocity_at_its_surface_point():
 def test_the_library_has_every_variant():
     """The shim's build carries each combination of the model's options the tests use."""
     assert set(shim.functions()) == set(shim.VARIANTS)
+
+
+def _slow_shrink(label, nu_s):
+    """law_contract's max_explicit_slips rows with mu_k = 63/128 (Fmin = 31/64, r = 31/32 for
+    15/16): the part q across u stays larger through the 100 slips followed one by one
+    (0.0104 after them, not 4e-4), so E7's closed form after them differs from one taken
+    after 50 by 1.3e-3 along u, above float's bound 800 eps (T + rate) = 4.3e-4 (which the
+    original rows' 5e-5 is not); and the slides row (nu_s = 1/4096: kept = T - Fmin) meets
+    E7 with L = 0 instead of rounding into E4 as the original does in float, where
+    1 - t.u falls to its rounding."""
+    return lc.Case(f"max_explicit_slips_{label}_slow_shrink", "E7 after MAX_EXPLICIT_SLIPS slips (float rows)", "wall",
+                   (lc.Segment(16, lc.ALONG_X), lc.Segment(1, (0.0, 64.0, 0.0))), 0.5, 63 / 128, nu_s=nu_s,
+                   timing="exact")
+
+
+E7_CASES = [c for c in lc.CASES if c.name.startswith("max_explicit_slips")] + [
+    _slow_shrink("periodic", 0.0), _slow_shrink("slides", 1 / 4096)]
+
+
+@pytest.mark.parametrize("case", E7_CASES, ids=lambda c: c.name)
+def test_closed_form_after_the_followed_slips_in_float(case):
+    """E7 in float, along u and across it. Along u (the slips' times summed: law_contract's
+    bound, 800 eps (T + rate)); across u, a bound of its own: the part q shrinks by r at
+    each slip exactly in arithmetic, and each slip adds to it the roundings of adding along
+    u and of taking q out (4 eps T), which shrink by r after: at most 4 eps T / (1 - r), plus
+    the relative rounding of q itself over the N + n slips (3 (N + n) eps |q|). The shim's
+    own differences are ~5e-10; q's sign turned would be 3e-4."""
+    lc.compare(case, shim.run_case(case), dtype=F32)
+    lc.compare(case, shim.run_case(case, sweep=True), dtype=F32)
+    T, fmin = case.mu_s, 2 * case.mu_k - case.mu_s
+    r = fmin / T
+    theta, a, q, rest, L = lc.max_slips_follow(case)
+    n = math.floor(rest / L) if L > 0 else 0
+    q_end = r ** n * q
+    bound = 4 * F32_EPS * T / (1 - r) + 3 * (100 + n) * F32_EPS * q_end
+    got = shim.run_case(case)["F"][-1]
+    want_across = -q_end if L > 0 else 0.0  # (the force on i: its part across u along -x, law_contract)
+    assert abs(got[0] - want_across) <= bound, (got[0], want_across, bound)
+
+
+F32_EPS = 2.0 ** -23

@@ -140,6 +140,13 @@ def new_solver(deme):
     return solver
 
 
+def wall_angle(scene, w, step):
+    """A wall's angle after `step` steps (0 for a fixed one): rate dt min(step, steps turning)."""
+    if w.rotation is None:
+        return 0.0
+    return scene.rotation_rate(w) * scene.dt * min(step, scene.rotation_steps(w))
+
+
 def build(scene, deme):
     """The solver for a checked scene, not yet initialised: (solver, {grain name: (tracker,
     family)}). The force model: stickslip_deme.attach(normal="hooke", record=True)."""
@@ -192,6 +199,13 @@ def build(scene, deme):
     return solver, grains
 
 
+def steps_duration(n, dt):
+    """The duration to ask DoDynamics for n steps: the engine steps while its elapsed time,
+    summed in its float time step (float(dt) differs from dt by up to 2^-24 relatively), is
+    below the duration, so n dt may give n + 1 steps; (n - 1/2) dt gives n."""
+    return (n - 0.5) * dt
+
+
 def _record(solver, fam, ss):
     return ss.read_record(solver, fam)
 
@@ -213,6 +227,10 @@ def run(scene, out_dir, progress=None):
     ft = np.zeros((rows + 1, len(out.contacts), d))
     slips = np.zeros((rows + 1, len(out.contacts)), dtype=int)
     last_count = np.zeros(len(out.contacts))
+    # the recorded walls' angles: as prescribed (turning_prescription), pyref's of each step
+    turning = [next(w for w in scene.walls if w.name == name) for name in out.walls]
+    angle = np.array([[wall_angle(scene, w, r * every) for w in turning] for r in range(rows + 1)]).reshape(
+        rows + 1, len(turning))
 
     def sample(r, step):
         for i, name in enumerate(out.grains):
@@ -236,7 +254,7 @@ def run(scene, out_dir, progress=None):
     t1 = time.perf_counter()
     sample(0, 0)
     for r in range(1, rows + 1):
-        solver.DoDynamicsThenSync(every * dt)
+        solver.DoDynamicsThenSync(steps_duration(every, dt))
         sample(r, r * every)
         if progress is not None and (r % max(1, rows // 200) == 0 or r == rows):
             progress(r * every, scene.steps)
@@ -244,7 +262,7 @@ def run(scene, out_dir, progress=None):
     for arr in (x, v, fn, ft):
         if not np.isfinite(arr).all():
             raise RuntimeError("DEM-Engine: a non-finite position, velocity or contact force")
-    rec = _Recording(t, x, v, fn, ft, slips)
+    rec = _Recording(t, x, v, fn, ft, slips, angle)
     notes = [f"DEM-Engine: {t_init:.0f} s to initialise (JIT compile), {wall:.1f} s to run; float arithmetic"]
     return RunResult(columns.frame(scene, rec), scene.steps, wall, notes)
 
@@ -252,5 +270,5 @@ def run(scene, out_dir, progress=None):
 class _Recording:
     """The fields columns.frame reads (pyref.Recording's names)."""
 
-    def __init__(self, t, x, v, fn, ft, slips):
-        self.t, self.x, self.v, self.fn, self.ft, self.slips = t, x, v, fn, ft, slips
+    def __init__(self, t, x, v, fn, ft, slips, angle):
+        self.t, self.x, self.v, self.fn, self.ft, self.slips, self.angle = t, x, v, fn, ft, slips, angle
