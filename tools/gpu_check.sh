@@ -4,8 +4,7 @@
 #   bash tools/gpu_check.sh BUNDLE [JIT_CACHE] [deme_gpu_check.py options]
 #
 # BUNDLE: deme-bundle.tar.xz, DEM-Engine 3.0.19 (PyPI deme) with the CUDA 12.8 runtime, NVRTC
-# and headers it compiles with (~39 MB; made with network by the team's deme_bundle.sh, see
-# deme_model/README.md). JIT_CACHE: a jit-cache.tar.xz an earlier run left in $OUT (its
+# and headers it compiles with (~39 MB; made where PyPI can be reached by tools/deme_bundle.sh). JIT_CACHE: a jit-cache.tar.xz an earlier run left in $OUT (its
 # compiled kernels: a second run skips minutes of compiling), or "" for none.
 # Unpacks the bundle under /tmp/gpu_check, links its share/, include/ and lib64/ into the
 # interpreter's purelib folder (DEM-Engine looks for its kernel sources there), then runs
