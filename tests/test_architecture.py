@@ -100,13 +100,11 @@ def test_adapters_know_only_their_engine_and_the_time_series_columns():
 
 def test_benchmarks_and_studies_are_leaves():
     """Benchmarks are reached from the command line only; studies from the command line and
-    the report (the case kinds and analysis read stick_resolution, the one study helper a
-    run's summary uses). Nothing they do is needed to run a scene."""
+    the report. Nothing they do is needed to run a scene."""
     g = graph()
     for name, deps in g.items():
         for dep in deps:
             if dep.startswith("stickslip.bench") and not name.startswith("stickslip.bench"):
                 assert name == "stickslip.cli", (name, dep)
             if dep.startswith("stickslip.studies") and not name.startswith(("stickslip.studies", "stickslip.bench")):
-                assert name in ("stickslip.cli", "stickslip.report") or dep == "stickslip.studies.stick_resolution", \
-                    (name, dep)
+                assert name in ("stickslip.cli", "stickslip.report"), (name, dep)

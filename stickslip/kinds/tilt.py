@@ -11,7 +11,7 @@ import numpy as np
 from pyref.laws import every_step_slips_speed
 
 from .. import plotstyle
-from ..studies import stick_resolution
+from . import stick_resolution
 from .paper import Statement, near
 
 NAME = "tilt"
