@@ -17,7 +17,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-from stickslip.adapters import liggghts_bench as b  # noqa: E402
+from stickslip.bench import liggghts as b  # noqa: E402
 from speed_dump_runs import run_cases  # noqa: E402
 
 if len(sys.argv) != 3:
