@@ -4,12 +4,14 @@ An adapter is a module `stickslip/adapters/<engine>.py` that satisfies `Adapter`
 (docs/adapters.md quotes it). It knows only its engine and the scene; it never
 computes headline figures (stickslip/analysis.py does, for every engine alike).
 `get(name)` imports an adapter lazily, so an engine that is not installed costs
-nothing until it is asked for. Engine tooling (benchmarks) sits beside it as
-`<engine>_bench.py`.
+nothing until it is asked for. Beside the adapters: their dump readers
+(text_dumps.py) and what the LAMMPS-family ones share (lammps_family.py); an engine's
+benchmark is stickslip/bench/<engine>.py.
 """
 from __future__ import annotations
 
 import importlib
+import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Protocol
@@ -46,6 +48,16 @@ class Adapter(Protocol):
         progress(done, total) now and then; raise ValueError (bad input the engine
         refused) or RuntimeError (the engine failed, non-finite values included) with
         a one-line message."""
+
+
+def missing(program, install, needed, build_hint):
+    """available()'s answer: None when `program` is on PATH and the file `needed` exists,
+    else why not in one line (`install` says how to get the program, `build_hint` the file)."""
+    if shutil.which(program) is None:
+        return f"`{program}` not on PATH ({install})"
+    if not needed.is_file():
+        return f"{needed} missing ({build_hint})"
+    return None
 
 
 def get(name) -> Adapter:
