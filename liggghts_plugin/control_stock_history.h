@@ -5,7 +5,7 @@
    build and place (compiler flags, a separate shared object, its own template instances
    of the pair loop) cost without any of the law's arithmetic:
      cmake -S liggghts_plugin -B build/liggghts_control -DCMAKE_CXX_FLAGS=-DSTICK_SLIP_CONTROL_STOCK
-     python -m stickslip.adapters.liggghts_bench --control build/liggghts_control/liggghts-stickslip
+     python -m stickslip.bench.liggghts --control build/liggghts_control/liggghts-stickslip
    The settings stick_slip alone has (exact_slip_timing, ...) are refused by this build. */
 
 template<>

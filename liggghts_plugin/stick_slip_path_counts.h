@@ -1,7 +1,7 @@
 /* stickslip: counts of the paths through tangential stick_slip, for the cost analysis of
    issue 32 (where a contact-step's time goes). Off in the default build: STICK_SLIP_COUNT
    is then nothing. Built with `cmake -DSTICK_SLIP_PATH_COUNTS=ON` (a separate build
-   directory; stickslip/adapters/liggghts_paths.py does it), every path taken by an evaluation
+   directory; stickslip/bench/liggghts_paths.py does it), every path taken by an evaluation
    that updates the history adds one to its counter, and the counts are written when the program ends, one "name count" line
    each, to the file named by the environment variable STICK_SLIP_PATH_COUNTS (else stderr). */
 

@@ -1,11 +1,12 @@
 """Headline figures of a run, computed from the standard time series alone.
 
 The same code reads every engine's output, so engines are compared on equal terms:
-the scene's case kind (stickslip/kinds/) computes them, stick_resolution.py warns.
+the scene's case kind (stickslip/kinds/) computes them, kinds/stick_resolution.py warns.
 """
 from __future__ import annotations
 
-from . import kinds, stick_resolution
+from . import kinds
+from .kinds import stick_resolution
 
 
 def summarise(scene, df) -> dict:

@@ -1,7 +1,7 @@
 """The `stickslip` command: parses its arguments and calls the module that does the work.
 
-run -> runner.py, precision -> precision.py, thresholds -> thresholds.py,
-bench -> bench.py, report -> report.py, drum-study -> drum_study.py, drum-engines ->
+run -> runner.py, report -> report.py, bench -> bench/table.py, precision, thresholds,
+drum-study and drum-engines -> studies/precision.py, thresholds.py, drum_study.py,
 drum_engines.py. Bad arguments or a bad scene: one line on
 stderr, exit status 2; an engine that fails, a file that cannot be written, or a fault of
 ours: one line, exit status 1 (STICKSLIP_TRACEBACK=1 shows the traceback of a fault).
@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from . import scene as scene_mod
-from .adapters import ENGINES
+from .adapters import ENGINES, OPTIONAL_ENGINES
 from .errors import EngineError, SceneError
 
 
@@ -61,7 +61,7 @@ def build_parser():
 
     r = sub.add_parser("run", help="run one scene on one engine")
     r.add_argument("scene", help="a case name in cases/ (drag, tray, tilt, ...) or a path to a .toml scene")
-    r.add_argument("--engine", default="pyref", choices=ENGINES)
+    r.add_argument("--engine", default="pyref", choices=ENGINES + OPTIONAL_ENGINES)
     r.add_argument("--dt", type=_positive, help="time step, s (default: the scene's)")
     r.add_argument("--duration", type=_positive, help="simulated time, s (default: the scene's)")
     r.add_argument("--law", choices=scene_mod.LAWS, help="tangential law (default: the scene's)")
@@ -184,7 +184,7 @@ def cmd_run(args):
 
 def cmd_precision(args):
     from . import kinds
-    from .precision import DEFAULT_FACTORS, ladder, run_precision
+    from .studies.precision import DEFAULT_FACTORS, ladder, run_precision
     from .runner import prepare_output
 
     sc = scene_mod.load(args.scene)  # validate first: a bad scene is a one-line error
@@ -212,7 +212,7 @@ def cmd_precision(args):
 
 def cmd_thresholds(args):
     from .runner import prepare_output
-    from .thresholds import run_thresholds
+    from .studies.thresholds import run_thresholds
 
     out = prepare_output(args.out)
     for r in run_thresholds(out):
@@ -223,7 +223,7 @@ def cmd_thresholds(args):
 
 
 def cmd_bench(args):
-    from .bench import run_bench
+    from .bench.table import run_bench
     from .runner import prepare_output
 
     run_bench(prepare_output(args.out), reps=args.reps, engines=args.engines, report=args.report)
@@ -233,7 +233,7 @@ def cmd_bench(args):
 def cmd_drum_study(args):
     import tomllib
 
-    from .drum_study import run_study
+    from .studies.drum_study import run_study
 
     path = scene_mod.find(args.scene)
     rate = args.rate or abs(tomllib.loads(path.read_text()).get("gravity_rate", 0.0)) or None
@@ -246,7 +246,7 @@ def cmd_drum_study(args):
 
 
 def cmd_drum_engines(args):
-    from . import drum_engines
+    from .studies import drum_engines
 
     drum_engines.run(args.out, args.runs, args.engines, args.duration, args.parts, progress=not args.quiet)
     return 0

@@ -10,10 +10,11 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from . import adapters, drum_study, kinds, parallel, runner
+from . import adapters, kinds, parallel, runner
 from .kinds import paper
 from . import scene as scene_mod
-from .studies import plan as study_plan
+from .studies import drum_study
+from .studies.report_plan import plan as study_plan
 
 CASES = ("drag", "tray", "tilt")  # the paper's three examples (section 3), in cases/
 

@@ -91,6 +91,31 @@ def pytest_sessionfinish(session):
             print(line)
 
 
+# STICKSLIP_TEST_CPU=FILE: each test's CPU seconds (this process and the engines it ran and
+# waited for: user + system), appended to FILE as "seconds<TAB>test id" lines. Wall times
+# move with the machine's load; CPU times much less, which is what a profile of the suite
+# on a shared machine needs (docs/testing.md).
+_CPU_LOG = os.environ.get("STICKSLIP_TEST_CPU")
+
+
+def _cpu_seconds():
+    import resource
+
+    return sum(u.ru_utime + u.ru_stime for u in (resource.getrusage(resource.RUSAGE_SELF),
+                                                   resource.getrusage(resource.RUSAGE_CHILDREN)))
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    if not _CPU_LOG:
+        yield
+        return
+    t0 = _cpu_seconds()
+    yield
+    with open(_CPU_LOG, "a") as f:
+        f.write(f"{_cpu_seconds() - t0:.2f}\t{item.nodeid}\n")
+
+
 def pytest_collection_modifyitems(config, items):
     if config.getoption("--runslow"):
         return

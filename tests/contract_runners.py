@@ -23,6 +23,10 @@ from stickslip import scene as scene_mod
 # YADE's law calls pyref's kernel (yade_law/stickslip_yade/kernel.py imports pyref/laws.py):
 # the law's arithmetic there is pyref's; its own tests check its geometry and integration.
 SHARED_KERNEL = {"yade": "runs pyref's kernel (yade_law/stickslip_yade/kernel.py imports pyref/laws.py)"}
+# Engines of stickslip.adapters.OPTIONAL_ENGINES, whose hardware CI lacks: where their law's
+# own file runs every row without it.
+CPU_SHIMS = {"deme": "tests/test_deme_shim.py: deme_model/stick_slip.cu compiled on the CPU (deme_model/shim/), "
+                     "every row in float"}
 
 
 def _state(case, seg, k_in_seg, start):

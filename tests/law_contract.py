@@ -260,8 +260,9 @@ def _cases():
 CASES = _cases()
 
 
-def expected(case: Case):
-    """Per step (1..steps): Expect, or None where the contact is apart (not compared)."""
+def expected(case: Case, dtype=np.float64):
+    """Per step (1..steps): Expect, or None where the contact is apart (not compared).
+    dtype: the engine's floating type (its rounding sets the bound of _max_slips_step)."""
     n = case.steps
     name = case.name
     if name == "threshold_reached_slips":
@@ -301,7 +302,7 @@ def expected(case: Case):
         return loading + [_flow_after_hit()]
     if name.startswith("max_explicit_slips"):
         dashpot = case.nu_s * ALONG_X[0] / X  # nu_s V along x, in units of w (exact: 1/128)
-        return [Expect(1.0, k + dashpot, k, 0) for k in range(1, 17)] + [_max_slips_step(case)]
+        return [Expect(1.0, k + dashpot, k, 0) for k in range(1, 17)] + [_max_slips_step(case, np.finfo(dtype).eps)]
     if name == "plastic_flow_exact_timing":
         return [Expect(1.0, k, k, 0) for k in range(1, 24)] + [Expect(1.0, 24, 24, 1), _plastic_flow_step()]
     if name == "slip_at_step_start_exact_timing":
@@ -381,7 +382,7 @@ def max_slips_follow(case):
     return theta, a, q, 1.0 - theta, (T - fmin - kept) / rate
 
 
-def _max_slips_step(case):
+def _max_slips_step(case, eps=EPS):
     """max_explicit_slips_*: the force at the end of the sliding step (units: absolute).
     Slides (L = 0): Fmin u applied, trial (Fmin + kept) u, spring -(trial + nu_s V)/Ks =
     Fmin along +y, all exact in binary. Periodic: trial = (Fmin + rate part) u + r^n q, with
@@ -398,7 +399,7 @@ def _max_slips_step(case):
         return Expect(1.0, tuple(-applied), tuple(-(trial + case.nu_s * np.array([0.0, V, 0.0])) / KS), 1)
     n = math.floor(rest / L)
     part = rest - n * L
-    bound = 100 * 8 * EPS * (T + rate)
+    bound = 100 * 8 * eps * (T + rate)
     assert bound < rate * min(part, L - part)  # n is not on the edge of a rounding
     F = (fmin + rate * part) * u + (fmin / T) ** n * q * np.array([-1.0, 0.0, 0.0])
     return Expect(1.0, tuple(-F), tuple(-F / KS), 1, tol=bound)
@@ -424,7 +425,7 @@ def _inside_step(case):
     return out
 
 
-def check_turning(case, trace):
+def check_turning(case, trace, eps=EPS):
     """Step 3 on a rigidly turning stuck pair: |D| stays |D_0| = 4/64 and D stays in the
     tangent plane. Round-off bound: each step's turn rounds |D| by a few ulps (a dot
     product, a square root, a quotient: <= 8 eps relative) and V_s, zero in exact
@@ -432,7 +433,9 @@ def check_turning(case, trace):
     adds eps omega d dt to D per step; over N steps |D| may drift by
     N (8 eps |D| + 4 eps omega d dt). A history projected without keeping its length
     loses |D| (1 - cos(omega dt)) ~ |D| (omega dt)^2/2 a step instead: 5e-5 |D| (fast) and
-    5e-9 |D| (slow) a step, 1e6 and 1e2 times that bound after 100 steps."""
+    5e-9 |D| (slow) a step, 1e6 and 1e2 times that bound after 100 steps. eps: the engine's
+    rounding (float: 2^-23, where the slow row's loss is below the bound: only the fast row
+    tells the rules apart)."""
     d0 = 4 * X
     loaded = case.segments[0].steps
     turn = case.segments[1]
@@ -441,8 +444,8 @@ def check_turning(case, trace):
     # and Ks = 1, so -F is D to the last bit (a negation and a division by 1)
     assert case.nu_s == 0 and KS == 1.0
     D = trace["D"] if trace["D"] is not None else -trace["F"] / KS
-    assert np.allclose(np.linalg.norm(D[loaded - 1]), d0, rtol=0, atol=4 * EPS * d0)
-    bound_per_step = 8 * EPS * d0 + 4 * EPS * abs(turn.omega) * (2 * R) * DT
+    assert np.allclose(np.linalg.norm(D[loaded - 1]), d0, rtol=0, atol=4 * eps * d0)
+    bound_per_step = 8 * eps * d0 + 4 * eps * abs(turn.omega) * (2 * R) * DT
     for k in range(loaded, len(D)):
         drift = abs(np.linalg.norm(D[k]) - d0)
         assert drift <= (k - loaded + 1) * bound_per_step, (k, drift, bound_per_step)
@@ -458,11 +461,13 @@ def vector(value, w):
     return np.array(value, float) if isinstance(value, tuple) else value * w
 
 
-def compare(case, trace):
-    """Each step's recorded Fn, force, spring and slip count against expected(case)."""
+def compare(case, trace, dtype=np.float64):
+    """Each step's recorded Fn, force, spring and slip count against expected(case). dtype:
+    the engine's floating type; a case's ulps are ulps of it (the count of roundings on the
+    path is the same in any binary format), its exact cases exact in it too."""
     if case.name.startswith("stuck_pair_turning"):
-        return check_turning(case, trace)
-    exp = expected(case)
+        return check_turning(case, trace, np.finfo(dtype).eps)
+    exp = expected(case, dtype)
     assert len(exp) == case.steps
     k0 = 0
     for seg in case.segments:
@@ -472,7 +477,8 @@ def compare(case, trace):
             if e is None:
                 continue
             F, D = -vector(e.f, w), vector(e.d, w)
-            tol = e.tol if e.tol is not None else case.ulps * np.spacing(max(np.abs(F).max(), np.abs(D).max()))
+            tol = e.tol if e.tol is not None else case.ulps * float(np.spacing(dtype(max(np.abs(F).max(),
+                                                                                      np.abs(D).max()))))
             got = {q: None if trace[q] is None else trace[q][k] for q in ("fn", "F", "D", "slips")}
             where = f"{case.name}: step {k + 1}"
             assert got["fn"] == e.fn, (where, "Fn", got["fn"], e.fn)
@@ -503,11 +509,12 @@ def expected_type_pair(pair):
     return sawtooth(1, 0, slips_at, fmin, 0, "spring", TYPE_PAIR_STEPS)
 
 
-def compare_type_pair(pair, trace, w):
-    """As compare(), within 1 ulp: the slip's rescaling Fmin/|F_t| is not always a power of 2."""
+def compare_type_pair(pair, trace, w, dtype=np.float64):
+    """As compare(), within 1 ulp (of dtype, the engine's floating type): the slip's rescaling
+    Fmin/|F_t| is not always a power of 2."""
     for k, e in enumerate(expected_type_pair(pair)):
         F, D = -e.f * w, e.d * w
-        tol = np.spacing(max(np.abs(F).max(), np.abs(D).max()))
+        tol = float(np.spacing(dtype(max(np.abs(F).max(), np.abs(D).max()))))
         where = f"types {pair}: step {k + 1}"
         assert trace["fn"][k] == e.fn, (where, trace["fn"][k])
         assert np.all(np.abs(trace["F"][k] - F) <= tol), (where, "force", trace["F"][k], F)

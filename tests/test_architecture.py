@@ -80,8 +80,31 @@ def test_pyref_knows_nothing_of_the_engines_or_the_package():
 
 def test_case_kinds_are_only_named_in_their_modules():
     """Report, precision, analysis and the runner loop over kinds: no kind is named there."""
-    for module in ("report", "precision", "analysis", "runner", "studies"):
+    for module in ("report", "studies/precision", "analysis", "runner", "studies/report_plan"):
         text = (ROOT / "stickslip" / f"{module}.py").read_text()
         code = "\n".join(line for line in text.splitlines() if not line.lstrip().startswith("#"))
         for kind in ("kinds.drag", "kinds.tray", "kinds.tilt", '"grain_x"', '"plate_angle"', "grain1"):
             assert kind not in code, (module, kind)
+
+
+def test_adapters_know_only_their_engine_and_the_time_series_columns():
+    """stickslip/adapters/ holds the adapters and their dump readers: no case kind, study,
+    benchmark, report or runner is known there (the runner calls them, not the reverse)."""
+    g = graph()
+    adapters = [n for n in g if n.startswith("stickslip.adapters")]
+    assert len(adapters) >= 6
+    for name in adapters:
+        for dep in g[name]:
+            assert dep.startswith(("stickslip.adapters", "pyref")) or dep == "stickslip.columns", (name, dep)
+
+
+def test_benchmarks_and_studies_are_leaves():
+    """Benchmarks are reached from the command line only; studies from the command line and
+    the report. Nothing they do is needed to run a scene."""
+    g = graph()
+    for name, deps in g.items():
+        for dep in deps:
+            if dep.startswith("stickslip.bench") and not name.startswith("stickslip.bench"):
+                assert name == "stickslip.cli", (name, dep)
+            if dep.startswith("stickslip.studies") and not name.startswith(("stickslip.studies", "stickslip.bench")):
+                assert name in ("stickslip.cli", "stickslip.report"), (name, dep)

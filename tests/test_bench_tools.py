@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from stickslip import callgrind
-from stickslip.ratio_interval import ratio_interval
+from stickslip.bench import callgrind
+from stickslip.bench.ratio_interval import ratio_interval
 
 
 def test_ratio_interval_covers_the_true_ratio_95_times_in_100():
@@ -163,7 +163,7 @@ def test_liggghts_bench_round_ratios_are_each_rounds_geometric_mean_of_quiet_blo
     """liggghts_bench takes the round as the interval's unit: per round the geometric mean
     of its quiet blocks' ratios (a noisy block left out, a round without a quiet one left
     out). Two rounds of made-up chunks, the ratios worked out by hand."""
-    from stickslip.adapters import liggghts_bench as lb
+    from stickslip.bench import liggghts as lb
 
     def run(cpus, foreign):
         return {"chunks": [{"cpu": c * lb.CHUNK, "foreign": f} for c, f in zip(cpus, foreign)]}

@@ -7,7 +7,9 @@ import re
 
 import pytest
 
-from stickslip import adapters, bench, kinds, report, thresholds
+from stickslip import adapters, kinds, report
+from stickslip.bench import pyref as pyref_bench
+from stickslip.studies import thresholds
 from stickslip import scene as scene_mod
 from stickslip.cli import main
 
@@ -52,8 +54,8 @@ def test_thresholds_writes_every_measured_speed_within_the_bisections_width(tmp_
 
 
 def lattice_contacts(n_grains):
-    """bench.packing's cubic lattice pressed together: each grain touches its 6 lattice
-    neighbours and the bottom layer the floor."""
+    """stickslip/bench/pyref.py's packing, a cubic lattice pressed together: each grain touches
+    its 6 lattice neighbours and the bottom layer the floor."""
     side = max(2, round(n_grains ** (1 / 3)))
     nz = max(2, round(n_grains / side**2))
     return 2 * (side - 1) * side * nz + side * side * (nz - 1) + side * side
@@ -63,10 +65,10 @@ def test_bench_on_small_packings(tmp_path, monkeypatch):
     """`bench --engines pyref --reps 1` on packings of 27 to 125 grains (a few seconds;
     the real sizes take minutes): every figure written, the contact counts those of the
     pressed lattice, the rates consistent with the times."""
-    monkeypatch.setattr(bench, "PYREF_SIZES", (27, 64, 125))
-    monkeypatch.setattr(bench, "STEP_BUDGET", 1000)
-    monkeypatch.setattr(bench, "CONTACT_TARGET_GRAINS", 64)
-    monkeypatch.setattr(bench, "TIMED_STEPS", 5)
+    monkeypatch.setattr(pyref_bench, "PYREF_SIZES", (27, 64, 125))
+    monkeypatch.setattr(pyref_bench, "STEP_BUDGET", 1000)
+    monkeypatch.setattr(pyref_bench, "CONTACT_TARGET_GRAINS", 64)
+    monkeypatch.setattr(pyref_bench, "TIMED_STEPS", 5)
     assert main(["bench", "--out", str(tmp_path), "--reps", "1", "--engines", "pyref"]) == 0
     rows = list(csv.DictReader(open(tmp_path / "bench.csv")))
     assert {r["benchmark"] for r in rows} == {"pyref", "effects"}
@@ -74,7 +76,7 @@ def test_bench_on_small_packings(tmp_path, monkeypatch):
     assert [int(r["case"].split()[0]) for r in sized] == [27, 64, 125]
     for r in sized:
         n = int(r["case"].split()[0])
-        # contacts are steady during the timed steps (bench.packing), so their mean is the count
+        # contacts are steady during the timed steps (pyref_bench.packing), so their mean is the count
         assert int(r["contacts"]) == lattice_contacts(n), r
         t, rate = float(r["seconds_per_step"]), float(r["contact_steps_per_s"])
         assert t > 0 and rate == pytest.approx(lattice_contacts(n) / t, rel=0.5 / lattice_contacts(n))

@@ -11,6 +11,7 @@ import pytest
 from stickslip import columns
 from stickslip import scene as scene_mod
 from stickslip.adapters import liggghts as liggghts_adapter
+from stickslip.adapters.text_dumps import read_dump
 from stickslip.cli import main
 from stickslip.kinds import drum
 from pyref import Simulation
@@ -264,7 +265,7 @@ def test_drum_study_smoke(tmp_path, monkeypatch):
     What it cannot show: the angles' differences. With 2-4 avalanches a run and a spread
     of ~4 deg between avalanches, their means are ~2-3 deg uncertain, as large as the
     differences the full study measures (docs/drum.md)."""
-    from stickslip import drum_study
+    from stickslip.studies import drum_study
 
     kw = dict(out=tmp_path / "out", out_runs=tmp_path / "runs", rate=0.03, duration=20.0,
               labels=drum_study.SMOKE_LABELS, full=False, ranks=1, progress=False)
@@ -339,7 +340,7 @@ def test_drum_on_yade_is_pyrefs_in_free_fall(tmp_path):
 def test_efolding_time_of_a_made_up_divergence():
     """A distance growing as 1e-20 m e^(t/3 ms) from round-off until it saturates at 1 mm
     (grains gone different ways): the fit over FIT_RANGE gives back the 3 ms."""
-    from stickslip.drum_engines import FIT_RANGE, efolding_time
+    from stickslip.studies.drum_engines import FIT_RANGE, efolding_time
 
     t = np.arange(0, 0.4, 4e-4)
     d = np.minimum(1e-20 * np.exp(t / 3e-3), 1e-3)
@@ -353,7 +354,7 @@ def test_consistent_mu_inverts_a_made_up_history_curve():
     """History angles rising as 10 + 40 mu deg (standard error 0.5); a stick-slip run at
     22 +- 0.5 deg agrees within two combined errors with mu in 0.3 -+ 2 sqrt(0.5^2 + 0.5^2) / 40;
     one at 5 deg with none."""
-    from stickslip import drum_figures
+    from stickslip.studies import drum_figures
 
     mus = [0.1, 0.2, 0.3, 0.4, 0.5]
     rows = [{"label": f"history_mu{m:.2f}", "mu_s": m, "mu_k": m, "theta_stop_mean_deg": 10 + 40 * m,
@@ -372,9 +373,9 @@ def test_a_dump_cut_short_is_one_line(tmp_path):
     block = "ITEM: TIMESTEP\n{}\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff pp\n0 1\n0 1\n0 1\nITEM: ATOMS id x \n"
     (tmp_path / "a.dump").write_text(block.format(0) + "1 0.5 \n2 0.25 \n" + block.format(10) + "1 0.5 \n")
     with pytest.raises(RuntimeError, match="cut short at step 10"):
-        liggghts_adapter._read_dump(tmp_path / "a.dump")
+        read_dump(tmp_path / "a.dump")
     (tmp_path / "b.dump").write_text(block.format(0) + "1 0.5 \n2 0.25 \n")
-    assert liggghts_adapter._read_dump(tmp_path / "b.dump")[0].tolist() == [[1.0, 0.5], [2.0, 0.25]]
+    assert read_dump(tmp_path / "b.dump")[0].tolist() == [[1.0, 0.5], [2.0, 0.25]]
 
 
 @pytest.mark.parametrize("args, words", [

@@ -39,7 +39,9 @@ from contextlib import redirect_stderr, redirect_stdout
 
 import pytest
 
-from stickslip import adapters, bench, cli, report, thresholds
+from stickslip import adapters, cli, report
+from stickslip.bench import table as bench_table
+from stickslip.studies import thresholds
 from stickslip import scene as scene_mod
 from stickslip.scene import reader
 
@@ -561,7 +563,7 @@ def standins(monkeypatch):
     monkeypatch.setattr(adapters, "get", lambda name: _Standin)
     monkeypatch.setattr(adapters, "available", lambda: (["pyref"], {}))
     monkeypatch.setattr(thresholds, "run_thresholds", _reached)
-    monkeypatch.setattr(bench, "run_bench", _reached)
+    monkeypatch.setattr(bench_table, "run_bench", _reached)
     monkeypatch.setattr(report, "build_report", _reached)
 
 

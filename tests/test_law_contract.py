@@ -8,7 +8,7 @@ import pytest
 import contract_runners as runners
 import law_contract as lc
 from conftest import skip_engine
-from stickslip.adapters import ENGINES
+from stickslip.adapters import ENGINES, OPTIONAL_ENGINES
 
 
 @pytest.mark.parametrize("engine", sorted(runners.RUNNERS))
@@ -20,9 +20,11 @@ def test_contract(case, engine):
 
 def test_every_engine_has_the_contract():
     """An engine added to stickslip.adapters.ENGINES must bring its contract runner (or
-    say whose kernel it runs)."""
+    say whose kernel it runs); an optional one (OPTIONAL_ENGINES) a runner or a CPU shim."""
     missing = set(ENGINES) - set(runners.RUNNERS) - set(runners.SHARED_KERNEL)
     assert not missing, f"engines without a contract runner in tests/contract_runners.py: {sorted(missing)}"
+    unpinned = set(OPTIONAL_ENGINES) - set(runners.RUNNERS) - set(runners.CPU_SHIMS)
+    assert not unpinned, f"optional engines whose law no test runs without their hardware: {sorted(unpinned)}"
     undecided = set(runners.RUNNERS) - set(runners.TYPE_PAIR_RUNNERS) - set(runners.NO_TYPE_PAIRS)
     assert not undecided, f"engines with neither a per-type-pair runner nor a reason: {sorted(undecided)}"
 

@@ -13,6 +13,7 @@ import pytest
 from stickslip import analysis
 from stickslip import scene as scene_mod
 from stickslip.adapters import liggghts as liggghts_adapter
+from stickslip.adapters.text_dumps import read_dump
 from conftest import needs_engine, paper_case, run_pyref
 
 needs_liggghts = needs_engine("liggghts")
@@ -386,11 +387,11 @@ def test_output_is_proportional_to_what_the_scene_records(tmp_path):
     sc.output.contacts = [[names[0], names[1]], [names[0], sc.walls[0].name]]
     small = liggghts_adapter.run(sc, tmp_path / "small").timeseries
     work = tmp_path / "small" / "liggghts"
-    atoms = liggghts_adapter._read_dump(work / "atoms.dump")
+    atoms = read_dump(work / "atoms.dump")
     assert all(len(f) == 2 for f in atoms.values())
-    pairs = liggghts_adapter._read_dump(work / "pairs.dump")
+    pairs = read_dump(work / "pairs.dump")
     assert all(set(f[:, :2].astype(int).ravel()) <= {1, 2} for f in pairs.values() if len(f))
-    stats = liggghts_adapter._read_dump(work / "stats.dump")
+    stats = read_dump(work / "stats.dump")
     assert sorted(stats) == sorted(atoms) and all(len(f) == 1 for f in stats.values())
     size_small = sum(p.stat().st_size for p in work.glob("*.dump"))
 

@@ -7,8 +7,8 @@ import pytest
 
 from stickslip import analysis
 from stickslip import scene as scene_mod
-from stickslip.precision import run_precision
-from stickslip.thresholds import formula, measure
+from stickslip.studies.precision import run_precision
+from stickslip.studies.thresholds import formula, measure
 from conftest import run_pyref, skip_engine
 
 

@@ -4,9 +4,9 @@ import pytest
 
 from stickslip import parallel, report, runner
 from stickslip import scene as scene_mod
-from stickslip.friction_speed import mean_friction
+from stickslip.studies.friction_speed import mean_friction
 from stickslip.runner import run_named
-from stickslip.thresholds import _measure_drag
+from stickslip.studies.thresholds import _measure_drag
 
 
 class _Planned(Exception):
@@ -61,7 +61,7 @@ def test_a_run_asked_for_twice_runs_once(monkeypatch, tmp_path):
 def test_bench_report_gives_the_reports_time_and_where_it_went(monkeypatch):
     """`stickslip bench --report`: the report's wall time, its runs' CPU time and the share
     of each part (here a report that logs two tasks, without running them)."""
-    from stickslip import bench
+    from stickslip.bench import table
 
     tray = runner.task("tray", "pyref", "unused", law="coulomb", slip_timing="step")
     rung = runner.task("tilt", "pyref", "unused", dt=4e-6, slip_timing="exact", duration=None)
@@ -71,7 +71,7 @@ def test_bench_report_gives_the_reports_time_and_where_it_went(monkeypatch):
         cpu_log += [(tray, 30.0), (rung, 20.0), (drag, 1.5)]
 
     monkeypatch.setattr(report, "build_report", fake_report)
-    rows = {r["case"]: r["value"] for r in bench.report_rows()}
+    rows = {r["case"]: r["value"] for r in table.report_rows()}
     (wall,) = [v for k, v in rows.items() if k.startswith("stickslip report, wall time s")]
     assert 0 <= wall < 5
     assert rows["CPU s of all its runs"] == 51.5

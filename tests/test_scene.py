@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from stickslip import scene as scene_mod
-from stickslip.scene import SceneError, reader
+from stickslip.scene import SceneError, grains, reader
 
 DRAG = scene_mod.find("drag").read_text()
 
@@ -157,7 +157,7 @@ def test_start_overlap_limit_is_max_start_overlap():
 
 
 def test_near_pairs_finds_every_touching_pair_without_a_quadratic_search():
-    """reader._near_pairs against all pairs, on grains whose radii span 1:100; and the
+    """grains.near_pairs against all pairs, on grains whose radii span 1:100; and the
     candidates it returns stay proportional to the grains when one big grain sits among
     many small ones (a search radius set by the big grain returned ~1000 per grain)."""
     rng = np.random.default_rng(3)
@@ -165,7 +165,7 @@ def test_near_pairs_finds_every_touching_pair_without_a_quadratic_search():
         n = 400
         x = rng.uniform(0, 0.05, (n, dim))
         r = 10 ** rng.uniform(-4, -2, n)
-        a, b = reader._near_pairs(x, r)
+        a, b = grains.near_pairs(x, r)
         found = {(min(i, j), max(i, j)) for i, j in zip(a, b)}
         i, j = np.triu_indices(n, 1)
         touching = np.linalg.norm(x[i] - x[j], axis=1) < r[i] + r[j]
@@ -174,14 +174,14 @@ def test_near_pairs_finds_every_touching_pair_without_a_quadratic_search():
     small = np.stack(np.meshgrid(np.arange(200), np.arange(200)), -1).reshape(-1, 2) * 2.1e-4
     x = np.vstack([small, [[-0.01, -0.01]]])
     r = np.r_[np.full(len(small), 1e-4), 2e-3]
-    a, _ = reader._near_pairs(x, r)
+    a, _ = grains.near_pairs(x, r)
     assert len(a) < 5 * len(x), len(a)
 
 
 def test_sizes_are_refused_before_any_grain_is_made(monkeypatch):
     """Steps, grains, grain-steps: refused from the numbers alone (a huge lattice used to be
     built first: 10^6 grains took 22 s and 0.9 GB); recorded values likewise, by rule."""
-    monkeypatch.setattr(reader, "_lattice", lambda *a: pytest.fail("a lattice was built"))
+    monkeypatch.setattr(reader, "lattice", lambda *a: pytest.fail("a lattice was built"))
     lattice = "\n[[lattice]]\norigin = [0.0, 1.0]\ncounts = [{n}, {n}]\nradius = 1e-4\ndensity = 2600\n"
     side = int(reader.MAX_GRAINS ** 0.5) + 1
     with pytest.raises(SceneError, match=r"lattice\[0\]\.counts: .* at most 1e\+07"):

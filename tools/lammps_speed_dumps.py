@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from stickslip.adapters import lammps_bench as b  # noqa: E402
+from stickslip.bench import lammps as b  # noqa: E402
 from speed_dump_runs import run_cases  # noqa: E402
 
 if len(sys.argv) != 3:

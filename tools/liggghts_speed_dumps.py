@@ -17,7 +17,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-from stickslip.adapters import liggghts_bench as b  # noqa: E402
+from stickslip.bench import liggghts as b  # noqa: E402
 from speed_dump_runs import run_cases  # noqa: E402
 
 if len(sys.argv) != 3:
@@ -56,7 +56,7 @@ def packing(extra, rec=False, pair_only=""):
 
 def pour(extra):
     s = (ROOT / "liggghts_plugin/examples/in.pour3d").read_text()
-    head, sep, _ = s.partition("run             100000")
+    head, sep, _ = s.partition("run             ${steps}")
     if not sep or s.count("absolute_damping on limitForce on") != 2:
         sys.exit("liggghts_plugin/examples/in.pour3d changed: this script's edits no longer apply")
     head = head.replace("absolute_damping on limitForce on", "absolute_damping on limitForce on " + extra)

@@ -2,14 +2,15 @@
 """Small deliberate bugs in the C++ law, each built and run against the tests: does the
 suite see it? (issue 31 item 5; the README's test section quotes the last result.)
 
-    .venv/bin/python tools/mutate_cpp.py [--engine liggghts|lammps] [--only ID ...] [--wide]
+    .venv/bin/python tools/mutate_cpp.py [--engine liggghts|lammps|deme] [--only ID ...] [--wide]
 
 For each mutant: copy the engine's source folder into build/mutants/<engine>/src (the
 repository's files are never touched), apply the mutant to the copy, rebuild in
 build/mutants/<engine>/build, and run the engine's test selection with the adapter
-pointed at that build (STICKSLIP_LIGGGHTS_BUILD, STICKSLIP_LAMMPS_BUILD). A mutant is found by the text it
-changes (a regular expression, whitespace-insensitive, that must match exactly `count`
-times), never by line number: a mutant whose text is not found, or found a different
+pointed at that build (STICKSLIP_LIGGGHTS_BUILD, STICKSLIP_LAMMPS_BUILD; DEM-Engine's force
+model: STICKSLIP_DEME_SHIM_BUILD, its CPU build for the tests). A mutant is found by the
+text it changes (a regular expression, whitespace-insensitive, that must match exactly
+`count` times), never by line number: a mutant whose text is not found, or found a different
 number of times, is an ERROR in the summary and makes the exit status 2, never a silent
 skip. Killed = some test failed; survived = the selection passed.
 
@@ -212,6 +213,80 @@ LAMMPS_MUTANTS = (
            "const bool flow_law = c.ratio == 1.0 && nu_s == 0.0;"),
 ) + exact_path_mutants(EXACT_H)
 
+# DEM-Engine: the force model deme_model/stick_slip.cu, built on the CPU through its shim
+# (deme_model/CMakeLists.txt); the same kinds, found in its own text.
+DEME_MUTANTS = (
+    Mutant("fmin_0.3pct", "Fmin off by 0.3 %",
+           "const float ss_fmin = (2.f * ss_mu_k_c - ss_mu_s_c) * ss_fnabs;",
+           "const float ss_fmin = (2.f * ss_mu_k_c - ss_mu_s_c) * ss_fnabs * 1.003f;"),
+    Mutant("threshold_gt_step", "> for >= at the threshold",
+           "bool ss_slipped = ss_F2 >= ss_T * ss_T;", "bool ss_slipped = ss_F2 > ss_T * ss_T;"),
+    Mutant("threshold_gt_exact_start", "> for >= at the threshold",
+           "ss_slipped = ss_slipped || dot(ss_F0, ss_F0) >= ss_T * ss_T;",
+           "ss_slipped = ss_slipped || dot(ss_F0, ss_F0) > ss_T * ss_T;"),
+    Mutant("threshold_gt_exact_loop", "> for >= at the threshold",
+           "if (ss_n == 0 && ss_f2 >= ss_T * ss_T) {", "if (ss_n == 0 && ss_f2 > ss_T * ss_T) {"),
+    Mutant("reset_spring_sign", "sign error in the spring reset",
+           ": ss_F / (-ss_ks_c);", ": ss_F / ss_ks_c;"),
+    Mutant("reset_total_sign", "sign error in the spring reset",
+           "ss_D = ss_total ? (ss_F + ss_nu_s_c * ss_vs) / (-ss_ks_c)",
+           "ss_D = ss_total ? (ss_F - ss_nu_s_c * ss_vs) / (-ss_ks_c)"),
+    Mutant("reset_exact_end_sign", "sign error in the spring reset",
+           "ss_D = (ss_trial + ss_nu_s_c * ss_vs) / (-ss_ks_c);", "ss_D = (ss_trial - ss_nu_s_c * ss_vs) / (-ss_ks_c);"),
+    Mutant("dashpot_sign", "sign error in the dashpot",
+           "float3 ss_F = -ss_ks_c * ss_D - ss_nu_s_c * ss_vs;", "float3 ss_F = -ss_ks_c * ss_D + ss_nu_s_c * ss_vs;"),
+    Mutant("dashpot_sign_exact_start", "sign error in the dashpot",
+           "const float3 ss_F0 = -ss_ks_c * ss_D0 - ss_nu_s_c * ss_vs;",
+           "const float3 ss_F0 = -ss_ks_c * ss_D0 + ss_nu_s_c * ss_vs;"),
+    Mutant("normal_damping_sign", "sign error in the dashpot",
+           "kn[bodyAMatType][bodyBMatType] * ss_delta + ss_nu_n_c * ss_vn",
+           "kn[bodyAMatType][bodyBMatType] * ss_delta - ss_nu_n_c * ss_vn"),
+    Mutant("turn_loses_length", "a turned history that loses its length",
+           "ss_D = ss_D * sqrtf(ss_old2 / ss_new2);", "ss_D = ss_D;"),
+    Mutant("exact_misses_whole_cycles", "exact timing that misses a slip inside the step",
+           "const float ss_whole = floorf(ss_rest / ss_L);", "const float ss_whole = 0.f;"),
+    Mutant("exact_misses_slip_at_start", "exact timing that misses a slip inside the step",
+           "ss_slipped = ss_slipped || dot(ss_F0, ss_F0) >= ss_T * ss_T;", "ss_slipped = ss_slipped;"),
+    Mutant("exact_slip_late", "exact timing that misses a slip inside the step",
+           "ss_dtheta = ss_rate > 0.f ? ss_gap / ss_rate : 2.f;", "ss_dtheta = ss_rate > 0.f ? 1.5f * ss_gap / ss_rate : 2.f;"),
+    Mutant("mu_s_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
+           "ss_mu_s_c = mu[bodyAMatType][bodyBMatType];", "ss_mu_s_c = mu[bodyAMatType][bodyAMatType];"),
+    Mutant("mu_k_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
+           "ss_mu_k_c = mu_k[bodyAMatType][bodyBMatType];", "ss_mu_k_c = mu_k[bodyBMatType][bodyBMatType];"),
+    Mutant("mu_k_read_from_mu", "mu_k read from the wrong place",
+           "ss_mu_k_c = mu_k[bodyAMatType][bodyBMatType];", "ss_mu_k_c = mu[bodyAMatType][bodyBMatType];"),
+    Mutant("mu_k_sweep_read_from_mu_s", "mu_k read from the wrong place",
+           ": ss_mu_k[AOwner];", ": ss_mu_s[AOwner];"),
+    Mutant("mu_sweep_pair_from_a_only", "a per-owner coefficient read from the wrong body",
+           "0.5f * (ss_mu_s[AOwner] + ss_mu_s[BOwner])", "0.5f * (ss_mu_s[AOwner] + ss_mu_s[AOwner])"),
+    Mutant("reset_total_ignored_step", "the reset rule `total` ignored",
+           "ss_D = ss_total ? (ss_F + ss_nu_s_c * ss_vs) / (-ss_ks_c) : ss_F / (-ss_ks_c);",
+           "ss_D = ss_F / (-ss_ks_c);"),
+    Mutant("reset_total_ignored_exact", "the reset rule `total` ignored",
+           "const float ss_kept = ss_total ? 0.f : ss_nu_s_c * ss_speed;", "const float ss_kept = ss_nu_s_c * ss_speed;"),
+    Mutant("flow_ignores_reset_total", "the reset rule `total` ignored",
+           "const bool ss_flow_law = ss_r == 1.f && (ss_total || ss_nu_s_c == 0.f);",
+           "const bool ss_flow_law = ss_r == 1.f && ss_nu_s_c == 0.f;"),
+    Mutant("recontact_keeps_spring", "re-contact does not start from a zero spring",
+           "ss_dx = 0.f; ss_dy = 0.f; ss_dz = 0.f; ss_slips = 0.f;", "ss_slips = 0.f;"),
+    Mutant("fn_signed", "|Fn| for a tensile Fn",
+           "const float ss_fnabs = fabsf(ss_fn);", "const float ss_fnabs = ss_fn;"),
+    Mutant("wall_point_not_shifted", "a turning wall's velocity at the contact point, not its surface",
+           "ss_cpB = ss_cpB + (0.5f * ss_delta) * ss_nB;", ""),
+    Mutant("flow_not_at_right_angle", "E6 (plastic flow) left out at t.u = 0",
+           "if (ss_flow_law && ss_tu >= 0.f) {", "if (ss_flow_law && ss_tu > 0.f) {"),
+    Mutant("flow_rest_inverted", "E6 (plastic flow) over the wrong share of the step",
+           "expf(-ss_rate * ss_rest / ss_T)", "expf(-ss_rate / ss_rest / ss_T)"),
+    Mutant("max_slips_counted_twice", "exact timing's closed form (E7) after 50 slips, not 100",
+           "ss_n++;", "ss_n += 2;"),
+    Mutant("periodic_across_sign", "E7's closed form with the part across u turned",
+           "+ ss_shrink * ss_q;", "- ss_shrink * ss_q;"),
+    Mutant("slid_at_zero_cycle", "E7 with a cycle of length 0 taken as periodic",
+           "if (!(ss_L > 0.f)) {", "if (!(ss_L >= 0.f)) {"),
+    Mutant("record_b_force_sign", "a sign error in what the record keeps",
+           "ss_rec_fy[BOwner] = -ss_F.y;", "ss_rec_fy[BOwner] = ss_F.y;"),
+)
+
 ENGINES = {
     "liggghts": Engine(
         source="liggghts_plugin", law_file="tangential_model_stick_slip.h", build_env="STICKSLIP_LIGGGHTS_BUILD",
@@ -229,6 +304,11 @@ ENGINES = {
         mutants=LAMMPS_MUTANTS,
         # the LAMMPS headers ./run.sh setup extracted (CMakeLists' default is relative to its source)
         cmake_args=(f"-DLAMMPS_HEADERS={REPO / 'build' / 'lammps_headers' / 'src'}",)),
+    "deme": Engine(
+        source="deme_model", law_file="stick_slip.cu", build_env="STICKSLIP_DEME_SHIM_BUILD",
+        fast=("tests/test_deme_shim.py",),
+        wide=("tests/test_deme_shim.py", "tests/test_deme_adapter.py"),
+        mutants=DEME_MUTANTS),
 }
 
 

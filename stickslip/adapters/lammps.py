@@ -20,19 +20,17 @@ and place over the step.
 """
 from __future__ import annotations
 
-import math
 import os
-import re
-import shutil
-import subprocess
-import time
 from pathlib import Path
 
 import numpy as np
 
 from . import RunResult
-from .ramp_script import bulk_dump, bulk_variables, ramp_loop, ramp_setup
-from .text_dumps import id_ranges, read_dump, timeseries
+from . import missing
+from .lammps_family import box, boundary, fmt as _fmt, gravity, integrated, run_script, vec as _vec, work_folder
+from . import ramp_script
+from .text_dumps import (atoms_dump, id_ranges, optional_dump, pair_record, recorded, run_lines, slips_dump,
+                         stats_dump, timeseries)
 
 NAME = "lammps"
 REPO = Path(__file__).resolve().parents[2]
@@ -48,19 +46,7 @@ LAW_KEYWORDS = "history_rotation keep_length lever_arm contact damping absolute 
 
 
 def available():
-    if shutil.which("lmp") is None:
-        return "LAMMPS not installed (apt-get install lammps liblammps-dev)"
-    if not LAUNCHER.is_file():
-        return f"plugin not built ({LAUNCHER} missing; ./run.sh setup builds it)"
-    return None
-
-
-def _fmt(x):
-    return repr(float(x))
-
-
-def _vec(a):
-    return " ".join(_fmt(x) for x in a)
+    return missing("lmp", "apt-get install lammps liblammps-dev", LAUNCHER, "./run.sh setup builds the plugin")
 
 
 def _full_precision(dump):
@@ -90,19 +76,6 @@ class _Script:
     def add(self, *lines):
         self.lines.extend(lines)
 
-    def _box(self):
-        sc = self.scene
-        pos = np.array([g.position for g in sc.grains])
-        rmax = max(g.radius for g in sc.grains)
-        pts = np.vstack([pos] + [w.point[None, :] for w in sc.walls]) if sc.walls else pos
-        margin = 10 * rmax + 0.02  # room for the grains to move
-        lo, hi = pts.min(axis=0) - margin, pts.max(axis=0) + margin
-        if sc.dimension == 2:
-            lo[2], hi[2] = -margin, margin  # z is periodic and inert in 2D
-        for axis, (a, b) in sc.periodic.items():  # the periodic box is the scene's own
-            lo["xyz".index(axis)], hi["xyz".index(axis)] = a, b
-        return lo, hi
-
     def _data_file(self, lo, hi):
         """The box and the grains (atom_style sphere: id type diameter density x y z; the
         Velocities section carries the spins). The masses are set afterwards, exactly the
@@ -131,15 +104,14 @@ class _Script:
 
     def _build(self):
         sc, eff = self.scene, self.scene.effects
-        lo, hi = self._box()
+        lo, hi, _ = box(sc)
         d2 = sc.dimension == 2
         self.add("# written by stickslip (stickslip/adapters/lammps.py) for scene " + sc.name, "units si")
         if d2:
             self.add("dimension 2")
         # atoms are not sorted in memory: the neighbour lists keep one order through the run
         self.add("atom_style sphere", "atom_modify map array sort 0 0.0", "comm_modify vel yes",
-                 "boundary " + ("f f p" if d2 else " ".join("p" if a in sc.periodic else "f" for a in "xyz")),
-                 f"read_data {self._data_file(lo, hi)}")
+                 boundary(sc), f"read_data {self._data_file(lo, hi)}")
         for g in sc.grains:
             self.add(f"set atom {self.ids[g.name]} mass {_fmt(sc.grain_mass(g))}")
         rmax = max(g.radius for g in sc.grains)
@@ -149,17 +121,11 @@ class _Script:
         for k, w in enumerate(sc.walls):
             self._wall(k, w, args, keywords)
         if eff["gravity"]:
-            self._gravity()
-        # rotation off: integrate translation only, spins stay zero; fixed grains are not
-        # integrated: they keep their place and zero velocity and spin
-        moving = "all"
-        fixed = [self.ids[g.name] for g in sc.grains if g.fixed]
-        if fixed:
-            # two fixed grains never act on each other: keep their pairs out of the neighbour list
-            self.add("group fixed id " + id_ranges(fixed), "group moving subtract all fixed",
-                     "neigh_modify exclude group fixed fixed")
-            moving = "moving"
+            self.add(*gravity(sc))
+        # rotation off: integrate translation only, spins stay zero
+        moving, lines = integrated(sc, self.ids)
         self.moving = moving
+        self.add(*lines)
         if eff["rotation"]:
             # a disk's inertia m r^2/2 in 2D (LAMMPS' default is a sphere's, 2/5)
             self.add(f"fix integrate {moving} nve/sphere" + (" disc" if d2 else ""))
@@ -214,32 +180,6 @@ class _Script:
                               "a grain")
         self.add(region, f"fix {fid} all wall/gran/region/stickslip hooke/history {args} region r{k} {keywords}")
 
-    def _gravity(self):
-        sc = self.scene
-        g = np.asarray(sc.gravity, float)
-        gn = float(np.linalg.norm(g))
-        if gn == 0:
-            return
-        if sc.gravity_ramp is not None:
-            self.add(*ramp_setup(sc))
-        elif sc.gravity_rate or sc.gravity_spinup[1]:
-            # turning gravity (Scene.gravity_at) as one angle, fix gravity's `spherical` style:
-            # it evaluates the variable at every step, `step` being the step whose positions
-            # it acts on (the arithmetic of stickslip/adapters/liggghts.py).
-            # 2D: (sin theta, cos theta), theta = theta0 - a; 3D: phi = phi0 + a (about z).
-            (r0, t0), deg, t = sc.gravity_spinup, 180.0 / math.pi, f"step*{_fmt(sc.dt)}"
-            a = f"({_fmt(r0 * deg)}*{t}+{_fmt((sc.gravity_rate - r0) * deg)}*({t}>{_fmt(t0)})*({t}-{_fmt(t0)}))"
-            u = g / gn
-            if sc.dimension == 2:
-                self.add(f"variable gtheta equal {_fmt(math.degrees(math.atan2(u[0], u[1])))}-{a}",
-                         f"fix gravity all gravity {gn!r} spherical 0.0 v_gtheta")
-            else:
-                theta, phi = math.degrees(math.acos(u[2])), math.degrees(math.atan2(u[1], u[0]))
-                self.add(f"variable gphi equal {_fmt(phi)}+{a}",
-                         f"fix gravity all gravity {gn!r} spherical v_gphi {_fmt(theta)}")
-        else:
-            self.add(f"fix gravity all gravity {gn!r} vector {_vec(g / gn)}")
-
     def _output(self):
         """Dumps of what the scene records, at its interval, and nothing else: the grains
         named in [output] grains and in [output] contacts (one group), with their wall
@@ -247,22 +187,12 @@ class _Script:
         inside LAMMPS to two numbers per row."""
         sc = self.scene
         every = sc.output.every
-        pair_contacts = [c for c in sc.output.contacts if c[1] in self.ids]
-        self.walls_of = sorted({c[1] for c in sc.output.contacts if c[1] in self.walls}, key=list(self.walls).index)
-        names = set(sc.output.grains) | {a for a, _ in sc.output.contacts} | {b for _, b in pair_contacts}
-        if sc.output.slip_stats:  # the sliding speed of every contact needs every grain
-            names = set(self.ids)
-        # the rows of every dump: at least one grain, so that the steps are always written
-        self.recorded = sorted(self.ids[n] for n in names) or [1]
+        pair_contacts, self.walls_of, self.recorded = recorded(sc, self.ids, self.walls)
         self.add("group rec id " + id_ranges(self.recorded))
-        cols = "id x y z vx vy vz omegax omegay omegaz"
-        for name in self.walls_of:
-            cols += "".join(f" f_{self.walls[name]}[{k}]" for k in range(WALL_FN, WALL_NSLIP + 1))
-        self.force_col = len(cols.split())  # with slip_stats: force and torque, for the half-step velocities
-        if sc.output.slip_stats:
-            cols += " fx fy fz tqx tqy tqz"
-        self.add(f"dump atoms rec custom {every} atoms.dump {cols}", "dump_modify atoms sort id",
-                 _full_precision("atoms"))
+        wall_cols = "".join(f" f_{self.walls[name]}[{k}]" for name in self.walls_of
+                            for k in range(WALL_FN, WALL_NSLIP + 1))
+        dump, self.force_col, _ = atoms_dump(every, wall_cols, sc.output.slip_stats)
+        self.add(dump, "dump_modify atoms sort id", _full_precision("atoms"))
         # a pair's record: ids, Fn, the tangential force on the first grain, its slip count
         local = "c_{0}ids[1] c_{0}ids[2] c_{0}[1] c_{0}[2] c_{0}[3] c_{0}[4] c_{0}[5]"
         record = "pair/local p11 p1 p2 p3 p12 cutoff radius"
@@ -273,20 +203,10 @@ class _Script:
         if sc.output.stats:
             self._stats_output(every)
         if sc.output.slip_stats:
-            # every grain pair's record at each recorded step and at the step before it: a
-            # counter that moved between them slipped in the row's step (columns.SLIP_STATS).
-            # The dump's next step comes from a variable.
             self.add(f"compute slips all {record}", "compute slipsids all property/local patom1 patom2 cutoff radius",
-                     f"variable slipnext equal (step%{every}=={every - 1})*(step+1)"
-                     f"+(step%{every}!={every - 1})*((floor(step/{every})+1)*{every}-1)",
-                     f"dump slips all local {every} slips.dump {local.format('slips')}",
-                     "dump_modify slips every v_slipnext", _full_precision("slips"))
-        if sc.output.bulk or sc.gravity_ramp is not None:
-            lines, _ = bulk_dump(sc, "bk_one", every)
-            self.add(*bulk_variables(sc, self.moving), "group bk_one id 1", *lines, _full_precision("bulk"))
-        self.add(f"thermo {max(1, sc.steps // 50)}", "thermo_style custom step atoms", "thermo_modify norm no")
-        # a ramp's run ends on its conditions: a loop of intervals (ramp_script.py)
-        self.add(*(ramp_loop(sc) if sc.gravity_ramp is not None else [f"run {sc.steps}"]))
+                     *slips_dump(every, local.format("slips")), _full_precision("slips"))
+        self.add(*ramp_script.bulk_dump(sc, self.moving, lambda d, n: _full_precision(d)))
+        self.add(*ramp_script.run(sc, run_lines))
 
     def _stats_output(self, every):
         """[output] stats, reduced in LAMMPS: contacts touching (grain pairs that overlap,
@@ -305,77 +225,27 @@ class _Script:
         spin = (f"+0.5*{inertia}*mass*c_sse_p[1]*c_sse_p[1]*(c_sse_p[2]*c_sse_p[2]+c_sse_p[3]*c_sse_p[3]"
                 "+c_sse_p[4]*c_sse_p[4])"
                 if sc.effects["rotation"] else "")
-        self.add(f'variable sse_e atom "0.5*mass*(vx*vx+vy*vy+vz*vz){spin}"',
-                 "compute sse_ke all reduce sum v_sse_e",
-                 f'variable sse_n equal "{"+".join(terms)}"', "variable sse_k equal c_sse_ke",
-                 "variable sse_an atom v_sse_n", "variable sse_ak atom v_sse_k",
-                 "group sse_one id 1",
-                 f"dump stats sse_one custom {every} stats.dump id v_sse_an v_sse_ak",
-                 _full_precision("stats"))
+        self.add(*stats_dump(every, "+".join(terms), spin), _full_precision("stats"))
 
     def text(self):
         return "\n".join(self.lines) + "\n"
 
 
 def _timeseries(script, work):
-    pairs = read_dump(work / "pairs.dump") if (work / "pairs.dump").is_file() else {}
+    pairs = optional_dump(work / "pairs.dump")
 
-    def record(a, b, atoms, row, steps):
-        ia = script.ids[a]
-        rec = np.zeros((len(steps), 5))  # fn, fs (3), cumulative slips
-        for r, s in enumerate(steps):
-            if b in script.walls:  # the wall's per-atom record, 5 columns a wall after the grain's 10
-                base = 10 + 5 * script.walls_of.index(b)
-                rec[r] = atoms[s][row[ia]][base:base + 5]
-                continue
-            ib = script.ids[b]
-            for line in pairs.get(s, ()):
-                if {int(line[0]), int(line[1])} == {ia, ib}:
-                    sign = 1.0 if int(line[0]) == ia else -1.0  # the record is the force on the first grain
-                    rec[r] = [line[2], *(sign * line[3:6]), line[6]]
-        return rec
+    def record(a, b, steps):  # a grain pair (every wall records per atom): pair/local's record
+        ia, ib = script.ids[a], script.ids[b]
+        return np.array([pair_record(pairs.get(s, ()), ia, ib, fn_col=2) or [0.0] * 5 for s in steps])
     return timeseries("LAMMPS", script, work, record, slip_fn_col=2)
 
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     scene.refuse_unsupported("LAMMPS", ("periodic", "gravity_ramp", "bulk"))
-    if scene.contact.law != "stick_slip":
-        raise ValueError(f"the LAMMPS plugin implements stick_slip only, not {scene.contact.law}")
-    if scene.output.energy:
-        # the record has each contact's tangential work, not its split into slips and dashpot
-        raise ValueError("output.energy: the LAMMPS adapter does not record the energy columns")
-    work = Path(out_dir).resolve() / "lammps"
-    work.mkdir(parents=True, exist_ok=True)
-    for old in work.glob("*.dump"):
-        old.unlink()
+    work = work_folder(scene, out_dir, "LAMMPS")
     script = _Script(scene, work)
     (work / "in.scene").write_text(script.text())
     cmd = [str(launcher or LAUNCHER), "-in", "in.scene", "-log", "log.lammps", "-echo", "none", "-nocite"]
-    env = dict(os.environ, OMP_NUM_THREADS="1")
-    if np_ranks > 1:
-        cmd = ["mpirun", "-np", str(np_ranks)] + cmd
-        if os.geteuid() == 0:  # OpenMPI refuses root unless told (CI runs as root)
-            env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    t0 = time.perf_counter()
-    loop, err = [], []
-    with open(work / "screen.txt", "w") as screen:
-        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                             encoding="utf-8", errors="replace", cwd=work, env=env)
-        for line in p.stdout:
-            screen.write(line)
-            fields = line.split()
-            if len(fields) == 2 and fields[0].isdigit() and progress is not None:
-                progress(int(fields[0]), scene.steps)
-            elif line.startswith("Loop time of"):
-                loop.append(float(fields[3]))
-            elif line.startswith("ERROR"):
-                # "ERROR: text (file:line)" or "ERROR on proc N: text (file:line)"
-                err.append(re.sub(r"\s*\([^()]*:\d+\)\s*$", "", line.split(":", 1)[1].strip()))
-        p.wait()
-    if err:
-        raise ValueError(f"LAMMPS: {err[0]}")
-    if p.returncode != 0 or not loop:
-        raise RuntimeError(f"LAMMPS failed (exit {p.returncode}); see {work / 'screen.txt'}")
+    loop_time = run_script("LAMMPS", cmd, work, scene.steps, progress, np_ranks, env={"OMP_NUM_THREADS": "1"})
     df = _timeseries(script, work)
-    steps = int(round(df["t"].iloc[-1] / scene.dt))  # a gravity ramp may end the run before time.duration
-    return RunResult(df, steps, sum(loop), notes=script.notes)
+    return RunResult(df, int(round(df["t"].iloc[-1] / scene.dt)), loop_time, notes=script.notes)  # a ramp may end it early

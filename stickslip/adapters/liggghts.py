@@ -11,20 +11,17 @@ LIGGGHTS), and a run whose output is not finite raises an error.
 """
 from __future__ import annotations
 
-import math
 import os
-import re
-import shutil
-import subprocess
-import time
 from pathlib import Path
 
 import numpy as np
 
 from . import RunResult
-from .ramp_script import bulk_dump, bulk_variables, ramp_loop, ramp_setup
-from .text_dumps import full_precision as _full_precision, id_ranges as _id_ranges, read_dump as _read_dump
-from .text_dumps import timeseries
+from .text_dumps import full_precision as _full_precision, id_ranges as _id_ranges
+from . import missing
+from .lammps_family import box, boundary, fmt as _fmt, gravity, integrated, run_script, vec as _vec, work_folder
+from . import ramp_script
+from .text_dumps import atoms_dump, optional_dump, pair_record, recorded, run_lines, slips_dump, stats_dump, timeseries
 
 NAME = "liggghts"
 REPO = Path(__file__).resolve().parents[2]
@@ -40,19 +37,8 @@ HISTORY_VALUES = 8
 
 
 def available():
-    if shutil.which("liggghts") is None:
-        return "LIGGGHTS not installed (apt-get install liggghts libliggghts-dev)"
-    if not LAUNCHER.is_file():
-        return f"plugin not built ({LAUNCHER} missing; ./run.sh setup builds it)"
-    return None
-
-
-def _fmt(x):
-    return repr(float(x))
-
-
-def _vec(a):
-    return " ".join(_fmt(x) for x in a)
+    return missing("liggghts", "apt-get install liggghts libliggghts-dev", LAUNCHER,
+                   "./run.sh setup builds the plugin")
 
 
 class _Script:
@@ -68,22 +54,6 @@ class _Script:
 
     def add(self, *lines):
         self.lines.extend(lines)
-
-    def _box(self):
-        sc = self.scene
-        pos = np.array([g.position for g in sc.grains])
-        rmax = max(g.radius for g in sc.grains)
-        pts = np.vstack([pos] + [w.point[None, :] for w in sc.walls]) if sc.walls else pos
-        # room for the grains to move and for turning walls (half-length `reach`)
-        margin = 10 * rmax + 0.02
-        lo, hi = pts.min(axis=0) - margin, pts.max(axis=0) + margin
-        if sc.dimension == 2:
-            # z is periodic and inert in 2D, but as thick as the plane: LIGGGHTS bins mesh
-            # walls in 3D and needs a bin on either side of the grains
-            lo[2], hi[2] = -margin, margin
-        for axis, (a, b) in sc.periodic.items():  # the periodic box is the scene's own
-            lo["xyz".index(axis)], hi["xyz".index(axis)] = a, b
-        return lo, hi, margin
 
     def _material(self):
         c, eff = self.scene.contact, self.scene.effects
@@ -144,7 +114,7 @@ class _Script:
 
     def _build(self):
         sc, eff = self.scene, self.scene.effects
-        lo, hi, margin = self._box()
+        lo, hi, margin = box(sc)
         self._lo, self._hi = lo, hi
         d2 = sc.dimension == 2
         self.add("# written by stickslip (stickslip/adapters/liggghts.py) for scene " + sc.name,
@@ -152,8 +122,7 @@ class _Script:
                  "communicate single vel yes")
         if d2:
             self.add("dimension 2")
-        boundary = "f f p" if d2 else " ".join("p" if a in sc.periodic else "f" for a in "xyz")
-        self.add(f"boundary {boundary}", f"read_data {self._data_file(lo, hi)}")
+        self.add(boundary(sc), f"read_data {self._data_file(lo, hi)}")
         rmax = max(g.radius for g in sc.grains)
         self.add(f"neighbor {_fmt(0.2 * rmax)} bin", "neigh_modify delay 0")
         model, settings = self._material()
@@ -186,38 +155,11 @@ class _Script:
             else:
                 self.add(f"fix move{k} all move/mesh mesh mesh{k} linear {_vec(w.velocity)}")
         if eff["gravity"]:
-            g = np.asarray(sc.gravity, float)
-            gn = float(np.linalg.norm(g))
-            if sc.gravity_ramp is not None:
-                self.add(*ramp_setup(sc))
-            elif gn > 0 and sc.gravity_rate:
-                # turning gravity (Scene.gravity_at) as one angle, the `spherical` style: fix
-                # gravity evaluates its variables at every step (`step` being the step whose
-                # positions it acts on), parsing each formula anew, so one short formula costs
-                # a quarter of the two of the `vector` style (16 % of the drum's step).
-                # 2D: (sin theta, cos theta), theta = theta0 - a; 3D: phi = phi0 + a (about z).
-                (r0, t0), deg, t = sc.gravity_spinup, 180.0 / math.pi, f"step*{_fmt(sc.dt)}"
-                a = f"({_fmt(r0 * deg)}*{t}+{_fmt((sc.gravity_rate - r0) * deg)}*({t}>{_fmt(t0)})*({t}-{_fmt(t0)}))"
-                u = g / gn
-                if d2:
-                    self.add(f"variable gtheta equal {_fmt(math.degrees(math.atan2(u[0], u[1])))}-{a}",
-                             f"fix gravity all gravity {gn!r} spherical 0.0 v_gtheta")
-                else:
-                    theta, phi = math.degrees(math.acos(u[2])), math.degrees(math.atan2(u[1], u[0]))
-                    self.add(f"variable gphi equal {_fmt(phi)}+{a}",
-                             f"fix gravity all gravity {gn!r} spherical v_gphi {_fmt(theta)}")
-            elif gn > 0:
-                self.add(f"fix gravity all gravity {gn!r} vector {_vec(g / gn)}")
-        # rotation off: integrate translation only, spins stay zero (nothing paid for them);
-        # fixed grains are not integrated: they keep their place and zero velocity and spin
-        moving = "all"
-        fixed = [self.ids[g.name] for g in sc.grains if g.fixed]
-        if fixed:
-            # two fixed grains never act on each other: keep their pairs out of the neighbour list
-            self.add("group fixed id " + _id_ranges(fixed), "group moving subtract all fixed",
-                     "neigh_modify exclude group fixed fixed")
-            moving = "moving"
+            self.add(*gravity(sc))
+        # rotation off: integrate translation only, spins stay zero (nothing paid for them)
+        moving, lines = integrated(sc, self.ids)
         self.moving = moving
+        self.add(*lines)
         self.add(f"fix integrate {moving} nve/sphere" if eff["rotation"] else f"fix integrate {moving} nve")
         for g in sc.grains:
             if g.imposed:
@@ -236,24 +178,13 @@ class _Script:
         LIGGGHTS to two numbers per row."""
         sc = self.scene
         every = sc.output.every
-        pair_contacts = [c for c in sc.output.contacts if c[1] in self.ids]
+        pair_contacts, self.walls_of, self.recorded = recorded(sc, self.ids, self.primitive)
         mesh_contacts = {c[1] for c in sc.output.contacts if c[1] in self.mesh}
-        self.walls_of = sorted({c[1] for c in sc.output.contacts if c[1] in self.primitive},
-                               key=list(self.primitive).index)
-        names = set(sc.output.grains) | {a for a, _ in sc.output.contacts} | {b for _, b in pair_contacts}
-        if sc.output.slip_stats:  # the sliding speed of every contact needs every grain
-            names = set(self.ids)
-        # the rows of every dump: at least one grain, so that the steps are always written
-        self.recorded = sorted(self.ids[n] for n in names) or [1]
         self.add("group rec id " + _id_ranges(self.recorded))
-        cols = "id x y z vx vy vz omegax omegay omegaz"
-        for name in self.walls_of:
-            cols += "".join(f" f_history_{self.primitive[name]}[{k}]" for k in range(RECORD_FN, RECORD_NSLIP + 1))
-        self.force_col = len(cols.split())  # with slip_stats: force and torque, for the half-step velocities
-        if sc.output.slip_stats:
-            cols += " fx fy fz tqx tqy tqz"
-        self.add(f"dump atoms rec custom {every} atoms.dump {cols}", "dump_modify atoms sort id",
-                 _full_precision("atoms", len(cols.split()), ints=1))
+        wall_cols = "".join(f" f_history_{self.primitive[name]}[{k}]" for name in self.walls_of
+                            for k in range(RECORD_FN, RECORD_NSLIP + 1))
+        dump, self.force_col, ncols = atoms_dump(every, wall_cols, sc.output.slip_stats)
+        self.add(dump, "dump_modify atoms sort id", _full_precision("atoms", ncols, ints=1))
         local = "c_{0}[1] c_{0}[2] c_{0}[3] " + " ".join(
             f"c_{{0}}[{3 + k}]" for k in range(RECORD_FN, RECORD_NSLIP + 1))
         if pair_contacts:
@@ -270,22 +201,11 @@ class _Script:
                      _full_precision("walls", 8))
         if sc.output.stats:
             self._stats_output(every)
-        if sc.output.slip_stats:
-            # every grain pair's record (ids, Fn, F_s, slip counter) at each recorded step and
-            # at the step before it: a counter that moved between them slipped in the row's
-            # step (columns.SLIP_STATS). The dump's next step comes from a variable.
-            self.add("compute slips all pair/gran/local id history",
-                     f"variable slipnext equal (step%{every}=={every - 1})*(step+1)"
-                     f"+(step%{every}!={every - 1})*((floor(step/{every})+1)*{every}-1)",
-                     f"dump slips all local {every} slips.dump {local.format('slips')}",
-                     "dump_modify slips every v_slipnext", _full_precision("slips", 8))
-        if sc.output.bulk or sc.gravity_ramp is not None:
-            lines, ncols = bulk_dump(sc, "bk_one", every)
-            self.add(*bulk_variables(sc, self.moving), "group bk_one id 1", *lines,
-                     _full_precision("bulk", ncols, ints=1))
-        self.add(f"thermo {max(1, sc.steps // 50)}", "thermo_style custom step atoms", "thermo_modify norm no")
-        # a ramp's run ends on its conditions: a loop of intervals (ramp_script.py)
-        self.add(*(ramp_loop(sc) if sc.gravity_ramp is not None else [f"run {sc.steps}"]))
+        if sc.output.slip_stats:  # (ids, Fn, F_s, slip counter)
+            self.add("compute slips all pair/gran/local id history", *slips_dump(every, local.format("slips")),
+                     _full_precision("slips", 8))
+        self.add(*ramp_script.bulk_dump(sc, self.moving, lambda d, n: _full_precision(d, n, ints=1)))
+        self.add(*ramp_script.run(sc, run_lines))
 
     def _stats_output(self, every):
         """[output] stats, reduced in LIGGGHTS: contacts touching (grain pairs that overlap,
@@ -311,39 +231,25 @@ class _Script:
         inertia = 0.5 if sc.dimension == 2 else 0.4
         spin = (f"+0.5*{inertia}*mass*c_sse_radius*c_sse_radius*(omegax*omegax+omegay*omegay+omegaz*omegaz)"
                 if sc.effects["rotation"] else "")
-        self.add(f'variable sse_e atom "0.5*mass*(vx*vx+vy*vy+vz*vz){spin}"',
-                 "compute sse_ke all reduce sum v_sse_e",
-                 f'variable sse_n equal "{"+".join(terms)}"', "variable sse_k equal c_sse_ke",
-                 "variable sse_an atom v_sse_n", "variable sse_ak atom v_sse_k",
-                 "group sse_one id 1",
-                 f"dump stats sse_one custom {every} stats.dump id v_sse_an v_sse_ak",
-                 _full_precision("stats", 3, ints=1))
+        self.add(*stats_dump(every, "+".join(terms), spin), _full_precision("stats", 3, ints=1))
 
     def text(self):
         return "\n".join(self.lines) + "\n"
 
 
 def _timeseries(script, work):
-    pairs = _read_dump(work / "pairs.dump") if (work / "pairs.dump").is_file() else {}
-    walls = _read_dump(work / "walls.dump") if (work / "walls.dump").is_file() else {}
+    pairs, walls = optional_dump(work / "pairs.dump"), optional_dump(work / "walls.dump")
 
-    def record(a, b, atoms, row, steps):
+    def record(a, b, steps):  # a grain pair or a mesh wall (primitive walls record per atom)
         ia = script.ids[a]
         rec = np.zeros((len(steps), 5))  # fn, fs (3), cumulative slips
         for r, s in enumerate(steps):
-            if b in script.primitive:  # the wall's per-atom history, 5 columns a wall after the grain's 10
-                base = 10 + 5 * script.walls_of.index(b)
-                rec[r] = atoms[s][row[ia]][base:base + 5]
-                continue
             blk = pairs.get(s) if b in script.ids else walls.get(s)
             if blk is None or not len(blk):
                 continue
             if b in script.ids:
-                ib = script.ids[b]
-                for line in blk:
-                    if {int(line[0]), int(line[1])} == {ia, ib}:
-                        sign = 1.0 if int(line[0]) == ia else -1.0  # the record is the force on the first grain
-                        rec[r] = [line[3], *(sign * line[4:7]), line[7]]
+                if (got := pair_record(blk, ia, script.ids[b], fn_col=3)) is not None:
+                    rec[r] = got
             else:  # a mesh wall: one row per touched triangle, summed
                 for line in blk[blk[:, 2].astype(int) == ia]:
                     rec[r, :4] += line[3:7]
@@ -355,46 +261,13 @@ def _timeseries(script, work):
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     scene.refuse_unsupported("LIGGGHTS", ("periodic", "gravity_ramp", "rolling", "bulk"))
-    if scene.contact.law != "stick_slip":
-        raise ValueError(f"the LIGGGHTS plugin implements stick_slip only, not {scene.contact.law}")
-    if scene.output.energy:
-        raise ValueError("output.energy: the LIGGGHTS adapter does not record the energy columns")
-    work = Path(out_dir).resolve() / "liggghts"
-    work.mkdir(parents=True, exist_ok=True)
-    for old in work.glob("*.dump"):
-        old.unlink()
+    work = work_folder(scene, out_dir, "LIGGGHTS")
     script = _Script(scene, work)
     (work / "in.scene").write_text(script.text())
     cmd = [str(launcher or LAUNCHER), "-in", "in.scene", "-log", "log.liggghts", "-echo", "none"]
     # one process needs no MPI daemon: OpenMPI's isolated singleton starts none (0.35 s of
     # every serial run, measured; same results)
-    env = dict(os.environ, OMPI_MCA_ess_singleton_isolated="1")
-    if np_ranks > 1:
-        cmd = ["mpirun", "-np", str(np_ranks)] + cmd
-        env = None
-        if os.geteuid() == 0:  # OpenMPI refuses root unless told (CI runs as root)
-            env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    t0 = time.perf_counter()
-    loop, err = [], []
-    with open(work / "screen.txt", "w") as screen:
-        # errors="replace": LIGGGHTS 3.8's Error::all() sometimes appends bytes read through
-        # a dangling pointer (its "special message"), which are not valid UTF-8
-        p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                             encoding="utf-8", errors="replace", cwd=work, env=env)
-        for line in p.stdout:
-            screen.write(line)
-            fields = line.split()
-            if len(fields) == 2 and fields[0].isdigit() and progress is not None:
-                progress(int(fields[0]), scene.steps)
-            elif line.startswith("Loop time of"):
-                loop.append(float(line.split()[3]))
-            elif line.startswith("ERROR"):
-                err.append(re.sub(r"\s*\([^()]*:\d+\)\s*$", "", line[6:].strip()))
-        p.wait()
-    if err:
-        raise ValueError(f"LIGGGHTS: {err[0]}")
-    if p.returncode != 0 or not loop:
-        raise RuntimeError(f"LIGGGHTS failed (exit {p.returncode}); see {work / 'screen.txt'}")
+    loop_time = run_script("LIGGGHTS", cmd, work, scene.steps, progress, np_ranks,
+                           serial_env={"OMPI_MCA_ess_singleton_isolated": "1"})
     df = _timeseries(script, work)
-    steps = int(round(df["t"].iloc[-1] / scene.dt))  # a gravity ramp may end the run before time.duration
-    return RunResult(df, steps, sum(loop) if loop else time.perf_counter() - t0)
+    return RunResult(df, int(round(df["t"].iloc[-1] / scene.dt)), loop_time)  # a ramp may end it early

@@ -25,9 +25,7 @@ import math
 
 import numpy as np
 
-
-def _fmt(x):
-    return repr(float(x))
+from .lammps_family import fmt as _fmt
 
 
 def bulk_variables(scene, group):
@@ -41,17 +39,28 @@ def bulk_variables(scene, group):
     return lines
 
 
-def bulk_dump(scene, one, every):
-    """The dump `bulk.dump` of grain `one`'s row (a group of one atom): the ramp's angle and
-    phase, then the bulk columns, per row (atom-style copies of equal-style variables)."""
+def bulk_dump(scene, moving, precision):
+    """The lines that write `bulk.dump` (when the scene has a ramp or output.bulk): the bulk
+    variables of the group `moving`, then on grain 1's row (a group of one atom) the ramp's
+    angle and phase and the bulk columns, per row (atom-style copies of equal-style
+    variables). precision(dump, ncols): the engine's dump_modify line for full precision."""
+    if not (scene.output.bulk or scene.gravity_ramp is not None):
+        return []
     names = []
     if scene.gravity_ramp is not None:
         names += ["rp_th", "rp_ph"]
     if scene.output.bulk:
         names += [f"bk_c{a}" for a in "xyz"] + [f"bk_v{a}" for a in "xyz"]
-    lines = [f"variable a_{n} atom v_{n}" for n in names]
-    lines.append(f"dump bulk {one} custom {every} bulk.dump id " + " ".join(f"v_a_{n}" for n in names))
-    return lines, len(names) + 1
+    return (bulk_variables(scene, moving) + ["group bk_one id 1"] + [f"variable a_{n} atom v_{n}" for n in names]
+            + [f"dump bulk bk_one custom {scene.output.every} bulk.dump id " + " ".join(f"v_a_{n}" for n in names),
+               precision("bulk", len(names) + 1)])
+
+
+def run(scene, run_lines):
+    """The run: `run_lines` (text_dumps.run_lines: progress, then one `run`), or with a ramp
+    the same progress lines and the control loop in place of the `run`."""
+    lines = run_lines(scene.steps)
+    return lines if scene.gravity_ramp is None else lines[:-1] + ramp_loop(scene)
 
 
 def ramp_setup(scene):

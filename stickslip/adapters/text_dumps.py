@@ -14,6 +14,59 @@ def full_precision(dump, ncols, ints=0):
     return f'dump_modify {dump} format "' + " ".join(["%d"] * ints + ["%.17g"] * (ncols - ints)) + '"'
 
 
+def recorded(scene, ids, walls):
+    """What a LAMMPS-family script dumps, and nothing else: the recorded pair contacts (both
+    grains in `ids`), the walls of `walls` whose contacts are recorded (in its order), and the
+    atom ids of the grains the dumps hold: those named in [output] grains and contacts (every
+    grain with slip_stats, whose sliding speeds need them all; at least one, so that every
+    output step is written)."""
+    out = scene.output
+    pair_contacts = [c for c in out.contacts if c[1] in ids]
+    walls_of = sorted({c[1] for c in out.contacts if c[1] in walls}, key=list(walls).index)
+    names = set(out.grains) | {a for a, _ in out.contacts} | {b for _, b in pair_contacts}
+    if out.slip_stats:
+        names = set(ids)
+    return pair_contacts, walls_of, sorted(ids[n] for n in names) or [1]
+
+
+def atoms_dump(every, wall_columns, slip_stats):
+    """The atoms dump of the recorded grains (group rec): id, place, velocity, spin, then
+    `wall_columns` (each recorded wall's per-atom record), then with slip_stats the force and
+    torque (for the half-step velocities). Returns its command, the index of its force
+    column and its number of columns."""
+    cols = "id x y z vx vy vz omegax omegay omegaz" + wall_columns
+    force_col = len(cols.split())
+    if slip_stats:
+        cols += " fx fy fz tqx tqy tqz"
+    return f"dump atoms rec custom {every} atoms.dump {cols}", force_col, len(cols.split())
+
+
+def slips_dump(every, entries):
+    """Every grain pair's record (`entries` of compute `slips`) at each output step and at the
+    step before it: a counter that moved between them slipped in the row's step
+    (columns.SLIP_STATS). The dump's next step comes from a variable."""
+    return [f"variable slipnext equal (step%{every}=={every - 1})*(step+1)"
+            f"+(step%{every}!={every - 1})*((floor(step/{every})+1)*{every}-1)",
+            f"dump slips all local {every} slips.dump {entries}", "dump_modify slips every v_slipnext"]
+
+
+def stats_dump(every, contacts, spin):
+    """[output] stats reduced inside the engine to two numbers per output step, written on
+    grain 1's row of stats.dump: `contacts` (an equal-style formula of the contacts touching)
+    and the kinetic energy, translational plus `spin` (a per-atom formula, "" without
+    rotation)."""
+    return [f'variable sse_e atom "0.5*mass*(vx*vx+vy*vy+vz*vz){spin}"', "compute sse_ke all reduce sum v_sse_e",
+            f'variable sse_n equal "{contacts}"', "variable sse_k equal c_sse_ke",
+            "variable sse_an atom v_sse_n", "variable sse_ak atom v_sse_k", "group sse_one id 1",
+            f"dump stats sse_one custom {every} stats.dump id v_sse_an v_sse_ak"]
+
+
+def run_lines(steps):
+    """The run, its progress printed 50 times (the adapters read it) as plain counts."""
+    return [f"thermo {max(1, steps // 50)}", "thermo_style custom step atoms", "thermo_modify norm no",
+            f"run {steps}"]
+
+
 def read_dump(path):
     """Blocks of a LAMMPS or LIGGGHTS dump: {step: 2D float array} ('atoms' or 'local' dumps).
     A block is ITEM: TIMESTEP, the step, ITEM: NUMBER OF ..., the count, ITEM: BOX BOUNDS
@@ -104,24 +157,47 @@ def slip_stats(script, atoms, slips, steps, fn_col):
     return [list(c) for c in zip(*rows)]
 
 
-def id_ranges(ids):
-    """Atom ids as LAMMPS/LIGGGHTS group ranges: 1 2 3 5 -> '1:3 5'."""
+def id_ranges(ids, through=":", sep=" "):
+    """Sorted whole numbers as runs: atom ids as LAMMPS/LIGGGHTS group ranges by default,
+    1 2 3 5 -> '1:3 5' (through="-", sep=",": '1-3,5')."""
     parts, start = [], ids[0]
     for prev, cur in zip(ids, ids[1:] + [None]):
         if cur != prev + 1:
-            parts.append(str(start) if start == prev else f"{start}:{prev}")
+            parts.append(str(start) if start == prev else f"{start}{through}{prev}")
             start = cur
-    return " ".join(parts)
+    return sep.join(parts)
+
+
+def wall_record(atom_row, k):
+    """The k-th wall's record in a grain's row of atoms.dump: Fn, the force on the grain (3),
+    the slips counted (5 columns a wall, after the grain's 10)."""
+    return atom_row[10 + 5 * k:15 + 5 * k]
+
+
+def pair_record(lines, ia, ib, fn_col):
+    """The record of the contact between atoms ia and ib in a block of a pair dump (its
+    columns from fn_col on: Fn, the force on the first atom (3), the slips counted), as the
+    force on ia; None where the block holds no such contact."""
+    for line in lines:
+        if {int(line[0]), int(line[1])} == {ia, ib}:
+            sign = 1.0 if int(line[0]) == ia else -1.0
+            return [line[fn_col], *(sign * line[fn_col + 1:fn_col + 4]), line[fn_col + 4]]
+    return None
+
+
+def optional_dump(path):
+    """read_dump of a dump the script writes only when the scene records such contacts."""
+    return read_dump(path) if path.is_file() else {}
 
 
 def timeseries(engine, script, work, contact_record, slip_fn_col):
     """The timeseries frame (stickslip/columns.py) from the dumps a LAMMPS-family script
     wrote into `work`: atoms.dump (the recorded grains: id x y z vx vy vz omegax omegay omegaz,
-    then the engine's per-wall records), stats.dump and slips.dump when the scene asks.
-    contact_record(a, b, atoms, row, steps): the engine's record of contact a-b at each
-    step, (steps, 5): Fn, the force on a (3), the slips counted since the contact began
-    (`row` maps an atom id to its row of the atoms dump). slip_fn_col: Fn's column in
-    slips.dump. A non-finite value stops with one line naming the column, time and step."""
+    then the per-atom records of the walls script.walls_of), stats.dump and slips.dump when
+    the scene asks. contact_record(a, b, steps): the engine's record of any other contact a-b
+    (pairs; LIGGGHTS' mesh walls) at each step, (steps, 5): Fn, the force on a (3), the
+    slips counted since the contact began. slip_fn_col: Fn's column in slips.dump. A
+    non-finite value stops with one line naming the column, time and step."""
     sc = script.scene
     d = sc.dimension
     atoms = read_dump(work / "atoms.dump")
@@ -139,7 +215,10 @@ def timeseries(engine, script, work, contact_record, slip_fn_col):
         blk = np.array([atoms[s][i] for s in steps])
         cols.update(zip(columns.grain(name, d, sc.effects["rotation"]), blk[:, picks].T))
     for a, b in sc.output.contacts:
-        rec = contact_record(a, b, atoms, row, steps)
+        if b in script.walls_of:
+            rec = np.array([wall_record(atoms[s][row[script.ids[a]]], script.walls_of.index(b)) for s in steps])
+        else:
+            rec = contact_record(a, b, steps)
         # slips since the previous row; a counter that drops means the contact was remade
         count = rec[:, 4]
         slips = np.diff(count, prepend=0.0)

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import subprocess
 import time
 from pathlib import Path
@@ -18,17 +17,14 @@ import pandas as pd
 
 from .. import columns
 from . import RunResult
+from . import missing
 
 NAME = "yade"
 RUNNER = Path(__file__).resolve().parents[2] / "yade_law" / "run_scene.py"
 
 
 def available():
-    if shutil.which("yade") is None:
-        return "`yade` not on PATH (apt-get install yade)"
-    if not RUNNER.is_file():
-        return f"{RUNNER} missing"
-    return None
+    return missing("yade", "apt-get install yade", RUNNER, "part of this repository: yade_law/")
 
 
 def scene_dict(scene):

@@ -1,4 +1,6 @@
-"""Case kinds: what a scene's `[analysis] kind` means, one module per kind.
+"""Case kinds: what a scene's `[analysis] kind` means, one module per kind, and what kinds
+share: paper.py (what the paper says, checked), stick_resolution.py (how well a run
+resolved its stick phases).
 
 A kind module provides (the contract; report, precision and analysis only loop):
 - NAME, and NAMES: the `[analysis]` keys it needs, each with its rule ("grain": a

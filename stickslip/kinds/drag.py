@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import plotstyle, stick_resolution
+from .. import plotstyle
+from . import stick_resolution
 from .paper import Statement, near
 
 NAME = "drag"

@@ -10,7 +10,8 @@ import numpy as np
 
 from pyref.laws import every_step_slips_speed
 
-from .. import plotstyle, stick_resolution
+from .. import plotstyle
+from . import stick_resolution
 from .paper import Statement, near
 
 NAME = "tilt"

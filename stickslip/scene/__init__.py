@@ -2,7 +2,8 @@
 
 `load(path_or_name, **overrides)` reads and validates a scene and returns a `Scene`
 (scene/model.py); any problem raises `SceneError` with a one-line message that names
-the key and the allowed range (scene/reader.py), so no engine ever sees an invalid
+the key and the allowed range (scene/reader.py; its tables scene/table.py, its grains
+scene/grains.py), so no engine ever sees an invalid
 scene. The largest stable time step, and the step below which collisions are accurate,
 are scene/stability.py. Format: docs/scene-format.md.
 """
@@ -10,7 +11,8 @@ from pyref.laws import LAWS, RESETS, SLIP_TIMINGS
 
 from ..errors import SceneError
 from .model import Contact, Grain, Output, Scene, Wall, WallRotation
-from .reader import CASES_DIR, EFFECTS, MAX_START_OVERLAP, check_contact, find, identity, load, parse
+from .grains import MAX_START_OVERLAP
+from .reader import CASES_DIR, EFFECTS, check_contact, find, identity, load, parse
 from .stability import (
                         CONTACT_STEPS,
                         IMPACT_STEPS,

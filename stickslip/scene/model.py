@@ -165,11 +165,11 @@ class Scene:
         """The features of this scene that not every engine has: {key: what it is, in words}."""
         out = {}
         if self.periodic:
-            out["periodic"] = f"periodic boundaries (periodic: {', '.join(self.periodic)})"
+            out["periodic"] = "periodic boundaries (periodic)"
         if self.gravity_ramp is not None:
-            out["gravity_ramp"] = "a gravity ramp with conditions (gravity_ramp)"
+            out["gravity_ramp"] = "gravity ramps (gravity_ramp)"
         if self.contact.rolling:
-            out["rolling"] = f"rolling resistance (contact.rolling = {self.contact.rolling!r})"
+            out["rolling"] = "rolling resistance (contact.rolling)"
         if self.output.bulk:
             out["bulk"] = "the bulk columns (output.bulk)"
         return out
@@ -178,7 +178,7 @@ class Scene:
         """One line (ValueError) if the scene needs a feature the engine lacks, never a silent run."""
         missing = [text for key, text in self.features().items() if key not in supported]
         if missing:
-            raise ValueError(f"{engine} cannot run scene {self.name}: it has no {'; no '.join(missing)}")
+            raise ValueError(f"{engine} cannot run scene {self.name}: it does not support {', '.join(missing)}")
 
     def moving_grains(self) -> list:
         return [g for g in self.grains if not g.fixed]

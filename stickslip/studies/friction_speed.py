@@ -16,8 +16,8 @@ import numpy as np
 from pyref import Simulation
 from pyref.laws import every_step_slips_speed
 
-from . import parallel, plotstyle, runner
-from . import scene as scene_mod
+from .. import parallel, plotstyle, runner
+from .. import scene as scene_mod
 
 SPEEDS = np.logspace(-6, -2, 17)  # m/s: 4 decades, past the dashpot threshold (~1e-3 m/s)
 DT_FACTORS = (4.0, 1.0, 0.25)  # x the drag scene's dt

@@ -25,11 +25,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import runner
-from .adapters import ENGINES
+from .. import runner
+from ..adapters import ENGINES
 from .drum_study import check_duration, load_run, run_one
-from .kinds import drum
-from .scene import find, load, parse
+from ..kinds import drum
+from ..scene import find, load, parse
 
 COST_DURATION = 1.0  # s: the fill falls (0.2 s) and sits as a pile of ~360 contacts
 DIVERGENCE_DURATION = 0.4  # s: round-off grows to the grains' size well before (measured)
@@ -113,7 +113,7 @@ def _name(column):
 
 
 def _plot_divergence(out, table, fits):
-    from .plotstyle import pyplot, save
+    from ..plotstyle import pyplot, save
 
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4))
@@ -167,8 +167,8 @@ def run(out, out_runs, engines, duration, parts, progress=True):
     """The parts asked for, each one's cost said first; results to `out`."""
     import sys
 
-    from . import adapters
-    from .errors import SceneError
+    from .. import adapters
+    from ..errors import SceneError
 
     missing = {e: adapters.get(e).available() for e in engines}
     missing = {e: why for e, why in missing.items() if why}

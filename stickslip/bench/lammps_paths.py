@@ -16,7 +16,7 @@ exact timing E0's test of the step's start.
 
 Cost: the -g build once (~20 s on 2 cores), then ~1 min (three callgrind runs, two at a time).
 
-    python -m stickslip.adapters.lammps_paths [--steps 500]
+    python -m stickslip.bench.lammps_paths [--steps 500]
 """
 from __future__ import annotations
 
@@ -30,8 +30,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-from .. import callgrind
-from . import lammps_bench as bench
+from ..adapters.text_dumps import id_ranges
+from . import callgrind
+from . import lammps as bench
 
 SOURCE = bench.ROOT / "lammps_plugin"
 LINES_BUILD = bench.ROOT / "build" / "lammps_plugin_lines"
@@ -135,18 +136,9 @@ def our_groups(runs, markers):
         for f, ln in sorted(set(lines)):
             where[f].append(ln)
         text = " = ".join(sorted(names[(part, n)])) if names[(part, n)] else \
-            "(" + "; ".join(f"{f}:{_ranges(v)}" for f, v in where.items()) + ")"
+            "(" + "; ".join(f"{f}:{id_ranges(v, through='-', sep=',')}" for f, v in where.items()) + ")"
         out.append((n, len(lines), f"{part}: {text}"))
     return sorted(out, key=lambda g: -g[0] * g[1])
-
-
-def _ranges(v):
-    parts, start = [], v[0]
-    for a, b in zip(v, v[1:] + [None]):
-        if b != a + 1:
-            parts.append(str(start) if start == a else f"{start}-{a}")
-            start = b
-    return ",".join(parts)
 
 
 def stock_groups(profile):
@@ -172,7 +164,7 @@ def _print(title, rows, per, share=0.002):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m stickslip.adapters.lammps_paths",
+    ap = argparse.ArgumentParser(prog="python -m stickslip.bench.lammps_paths",
                                  description=__doc__.split("\n\n")[0])
     ap.add_argument("--steps", type=int, default=STEPS, help="steps counted after the benchmark's warm-up")
     a = ap.parse_args(argv)

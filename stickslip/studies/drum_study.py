@@ -21,10 +21,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from . import drum_figures, runner
-from .errors import SceneError
-from .kinds import drum
-from .scene import find, parse
+from .. import runner
+from ..errors import SceneError
+from ..kinds import drum
+from ..scene import find, parse
+from . import drum_figures
 
 # Stock history is stick_slip with mu_k = mu_s and no tangential damping (the slip then
 # drops the force to mu Fn and leaves it there: a cap, as history's; docs/law.md).
@@ -193,7 +194,7 @@ def run_study(scene_path, out, out_runs, rate, duration, fill=None, seed=None, l
         f"{len(todo)} to run on LIGGGHTS ({jobs_at_once} at once, {ranks} MPI rank{'s' if ranks > 1 else ''} each), "
         f"about {sum(cost.values()) / 60:.0f} min\n")
     if jobs_at_once > 1:  # independent runs side by side: stickslip/parallel.py, longest first
-        from . import parallel
+        from .. import parallel
 
         tasks = [(cost[label], run_one, (sc, data, folder, "liggghts", ranks, keep_timeseries, False))
                  for label, sc, data, folder in todo]
@@ -266,7 +267,7 @@ def _table(study, figs):
         return "—" if not np.isfinite(m) else f"{m:.2f} ± {se:.2f}" if np.isfinite(se) else f"{m:.2f}"
 
     lines = ["# Drum study: the table", "",
-             "Written by `stickslip drum-study` (stickslip/drum_study.py); the findings: [../drum.md](../drum.md). "
+             "Written by `stickslip drum-study` (stickslip/studies/drum_study.py); the findings: [../drum.md](../drum.md). "
              "Means over the avalanches of each run with their standard errors (std / sqrt(n)); angles in degrees.",
              "θ: fit to the middle of the surface; θc: the centroid's angle (stickslip/kinds/drum.py).", "",
              "| run | μs | μk | νs | reset | timing | rate (rad/s) | dt (s) | avalanches (slides) | θ_start | θ_stop "

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import kinds, parallel, plotstyle, runner
-from . import scene as scene_mod
+from .. import kinds, parallel, plotstyle, runner
+from .. import scene as scene_mod
 
 DEFAULT_FACTORS = (8, 4, 2, 1, 0.5, 0.25)  # x the scene's dt: 6 steps over 1.5 decades
 TIMING_LINES = {"step": "--", "exact": "-"}

@@ -21,7 +21,7 @@ engine's geometry shared by both styles.
    over the timed steps alone, read from /proc/PID/schedstat by a probe that the input
    script runs (`shell`) before and after them. Each round's ratio divides two runs made
    seconds apart; the figure is the geometric mean over the rounds with a 95 % interval
-   (stickslip/ratio_interval.py). The CPU the rest of the machine used during each run is
+   (stickslip/bench/ratio_interval.py). The CPU the rest of the machine used during each run is
    recorded; rounds in which it exceeded NOISY cores are reported apart, and the ratio uses
    the quiet rounds when there are at least 3 (a busy second core slows a run through the
    shared caches even when the run keeps its core).
@@ -37,13 +37,12 @@ engine's geometry shared by both styles.
 Cost on the 2-core machine, idle: ~15 s once for the pour; ~4 s a round (10 by default);
 ~1 min of callgrind (two at a time); ~5 s per MPI repetition.
 
-    python -m stickslip.adapters.lammps_bench [--rounds 10] [--reps 3] [--no-callgrind] [--callgrind-steps 200]
+    python -m stickslip.bench.lammps [--rounds 10] [--reps 3] [--no-callgrind] [--callgrind-steps 200]
 """
 from __future__ import annotations
 
 import argparse
 import concurrent.futures
-import hashlib
 import math
 import os
 import re
@@ -55,10 +54,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from .. import callgrind
-from ..ratio_interval import ratio_interval
+from ..adapters.lammps import BUILD
+from . import callgrind
+from .data_cache import cached_data
 from .proc_probe import probe_script
-from .lammps import BUILD
+from .ratio_interval import ratio_interval
 
 ROOT = Path(__file__).resolve().parents[2]
 LAUNCHER = BUILD / "lmp-stickslip"
@@ -173,16 +173,12 @@ def _pour():
     if len(runs) != 2:
         raise RuntimeError(f"{EXAMPLE} changed: expected two `run 25000` lines")
     script = script[:runs[0].end()] + "\nwrite_data pour.data\n"
-    key = hashlib.sha1(script.encode()).hexdigest()[:12]
-    data = CACHE / f"pour-{key}.data"
-    if data.is_file():
-        return data
-    CACHE.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=CACHE) as tmp:
-        (Path(tmp) / "in.pour").write_text(script)
+
+    def make(tmp):
+        (tmp / "in.pour").write_text(script)
         _run([str(LAUNCHER), "-in", "in.pour", "-log", "none", "-echo", "none", "-nocite"], tmp)
-        os.replace(Path(tmp) / "pour.data", data)
-    return data
+        return tmp / "pour.data"
+    return cached_data(CACHE, "pour", script, make)
 
 
 def _command(config, nproc=1):

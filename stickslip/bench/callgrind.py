@@ -82,6 +82,7 @@ def total(profile):
 
 
 _NAME = re.compile(r"(c?fn)=\((\d+)\)(?: (.*))?")
+_FILE = re.compile(r"(c?fl|c?fi|fe)=\((\d+)\)(?: (.*))?")
 
 
 def _position(previous, text):
@@ -91,30 +92,47 @@ def _position(previous, text):
             else previous if text == "*" else int(text, 0))
 
 
-def self_costs(profile):
-    """Instructions per function in a profile, each function's own (what it calls excluded)."""
-    names, costs = {}, collections.Counter()
-    fn, call_cost_follows = None, False
+def _cost_lines(profile):
+    """Each cost line of a profile, as (function, source file, fields, call): the function
+    (fn=) and file (fl=, or fi=/fe= for code inlined into it, until the next fn=) it belongs
+    to, its whitespace-separated fields (positions compressed as _position reads them, then
+    the costs), and whether it is a call's inclusive cost (the line after calls=), which is
+    not the function's own. Names are written in full the first time, as (id) afterwards,
+    in one table per kind that calls (cfn=, cfi=, cfl=) fill too."""
+    functions, files = {}, {}
+    fn = file = fn_file = None
+    call = False
     with open(profile) as f:
         for line in f:
+            m = _FILE.match(line)
+            if m:
+                if m.group(3):
+                    files[m.group(2)] = m.group(3)
+                if not m.group(1).startswith("c"):  # a call's file names the callee: nothing changes here
+                    file = files.get(m.group(2), m.group(2))
+                    if m.group(1) == "fl":
+                        fn_file = file
+                continue
             m = _NAME.match(line)
             if m:
-                # a name is written in full the first time, as (id) afterwards
-                if m.group(3):
-                    names[m.group(2)] = m.group(3)
+                if m.group(3) and m.group(3).strip():
+                    functions[m.group(2)] = m.group(3).strip()
                 if m.group(1) == "fn":
-                    fn = names.get(m.group(2), m.group(2))
+                    fn, file = functions.get(m.group(2), m.group(2)), fn_file
                 continue
             if line.startswith("calls="):
-                call_cost_follows = True  # the next cost line is the call's inclusive cost
-                continue
-            if fn is not None and line[:1] in "0123456789+-*":
-                if call_cost_follows:
-                    call_cost_follows = False
-                    continue
-                fields = line.split()
-                if len(fields) >= 2:
-                    costs[fn] += int(fields[1])
+                call = True
+            elif line[:1] in "0123456789+-*":
+                yield fn, file, line.split(), call
+                call = False
+
+
+def self_costs(profile):
+    """Instructions per function in a profile, each function's own (what it calls excluded)."""
+    costs = collections.Counter()
+    for fn, _, fields, call in _cost_lines(profile):
+        if fn is not None and not call and len(fields) >= 2:
+            costs[fn] += int(fields[1])
     return costs
 
 
@@ -122,78 +140,27 @@ def instruction_counts(profile, want):
     """{function: {address: times run}} for the functions whose name `want` accepts, from a
     profile written with --dump-instr=yes (each cost line: address, line, instructions; an
     instruction's count is how often it ran)."""
-    names, runs = {}, collections.defaultdict(collections.Counter)
-    fn, address, call_cost_follows = None, 0, False
-    with open(profile) as f:
-        for line in f:
-            m = _NAME.match(line)
-            if m:
-                if m.group(3):
-                    names[m.group(2)] = m.group(3)
-                if m.group(1) == "fn":
-                    fn = names.get(m.group(2), m.group(2))
-                continue
-            if line.startswith("calls="):
-                call_cost_follows = True
-                continue
-            if line[:1] not in "0123456789+-*":
-                continue
-            fields = line.split()
-            address = _position(address, fields[0])
-            if call_cost_follows:  # a call's inclusive cost, at the call's address: not this instruction's runs
-                call_cost_follows = False
-                continue
-            if fn is not None and len(fields) >= 3 and want(fn):
-                runs[fn][address] += int(fields[2])
+    runs = collections.defaultdict(collections.Counter)
+    address = 0
+    for fn, _, fields, call in _cost_lines(profile):
+        address = _position(address, fields[0])
+        # a call's inclusive cost sits at the call's address: not this instruction's runs
+        if not call and fn is not None and len(fields) >= 3 and want(fn):
+            runs[fn][address] += int(fields[2])
     return runs
-
-
-_FILE = re.compile(r"(c?fl|c?fi|fe)=\((\d+)\)(?: (.*))?")
 
 
 def instruction_lines(profile, want):
     """{address: (function, source file, line, times run)} for the instructions whose source file
     `want` accepts, from a profile written with --dump-instr=yes --dump-line=yes of a
     program built with debug information (each cost line: address, line, instructions).
-    The file is the function's (fl=), or that of code inlined into it (fi=, fe=, until the
-    next fn=); a call's file (cfi=, cfl=) names the callee and changes nothing here, but may
-    be where a file's name is written (all share one table of names)."""
-    files, functions, runs = {}, {}, {}
-    fn_file = file = fn = None
+    The file is the function's, or that of code inlined into it (_cost_lines)."""
+    runs = {}
     address = line_no = 0
-    call_cost_follows = False
-
-    with open(profile) as f:
-        for raw in f:
-            m = _FILE.match(raw)
-            if m:
-                if m.group(3):
-                    files[m.group(2)] = m.group(3)
-                if m.group(1).startswith("c"):
-                    continue
-                file = files.get(m.group(2), m.group(2))
-                if m.group(1) == "fl":
-                    fn_file = file
-                continue
-            if raw.startswith(("fn=", "cfn=")):  # (a name may first be written at a call)
-                ident, _, name = raw[raw.index("(") + 1:].rstrip("\n").partition(")")
-                if name.strip():
-                    functions[ident] = name.strip()
-                if raw.startswith("fn="):
-                    fn, file = functions.get(ident, ident), fn_file
-                continue
-            if raw.startswith("calls="):
-                call_cost_follows = True
-                continue
-            if raw[:1] not in "0123456789+-*":
-                continue
-            fields = raw.split()
-            address = _position(address, fields[0])
-            line_no = _position(line_no, fields[1])
-            if call_cost_follows:  # a call's inclusive cost: not this instruction's runs
-                call_cost_follows = False
-                continue
-            if len(fields) >= 3 and file is not None and want(file):
-                old = runs.get(address, (fn, file, line_no, 0))
-                runs[address] = (fn, file, line_no, old[3] + int(fields[2]))
+    for fn, file, fields, call in _cost_lines(profile):
+        address = _position(address, fields[0])
+        line_no = _position(line_no, fields[1])
+        if not call and len(fields) >= 3 and file is not None and want(file):
+            old = runs.get(address, (fn, file, line_no, 0))
+            runs[address] = (fn, file, line_no, old[3] + int(fields[2]))
     return runs

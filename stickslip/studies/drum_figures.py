@@ -1,11 +1,11 @@
-"""The drum study's figures (stickslip/drum_study.py): the calibration map, the
+"""The drum study's figures (stickslip/studies/drum_study.py): the calibration map, the
 distributions of the avalanche angles, and slope traces."""
 from __future__ import annotations
 
 import numpy as np
 import pandas as pd
 
-from .plotstyle import pyplot, save
+from ..plotstyle import pyplot, save
 
 
 def history(study):

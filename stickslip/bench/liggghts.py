@@ -19,7 +19,7 @@ All figures come from one call, measured on the same 3D packing of 20 800 settle
      quiet blocks (all blocks, said so, when fewer than two are quiet), and more rounds run
      while there are fewer than MIN_QUIET_BLOCKS. A ratio is the geometric mean of the
      rounds' ratios (each the geometric mean of its blocks'), with a 95 % interval over
-     rounds (stickslip/ratio_interval.py): each round starts new processes, and processes
+     rounds (stickslip/bench/ratio_interval.py): each round starts new processes, and processes
      differ (memory placement) by more than blocks of one process do;
    - instructions, counted by callgrind over CALLGRIND_STEPS steps after the same warm-up
      (the same binaries and input: the count does not depend on the machine's load), in
@@ -36,7 +36,7 @@ Cost on the 2-core machine, idle: ~40 s per round (5 by default), ~1 min of call
 steps on 2 processes). On a busy machine everything is slower, and the rounds added for
 want of quiet blocks (up to 3 x) add to it.
 
-    python -m stickslip.adapters.liggghts_bench [--rounds 5] [--reps 3] [--no-callgrind] [--baseline LAUNCHER]
+    python -m stickslip.bench.liggghts [--rounds 5] [--reps 3] [--no-callgrind] [--baseline LAUNCHER]
         [--control LAUNCHER] [--stamp-cost]
 
 --control: a control build's launcher (liggghts_plugin/control_stock_history.h: stock history
@@ -47,7 +47,6 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
-import hashlib
 import math
 import os
 import re
@@ -59,10 +58,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from .. import callgrind
-from ..ratio_interval import ratio_interval
+from ..adapters.liggghts import BUILD, LAUNCHER
+from . import callgrind
+from .data_cache import cached_data
 from .proc_probe import probe_script
-from .liggghts import BUILD, LAUNCHER
+from .ratio_interval import ratio_interval
 
 CACHE = BUILD.parent / "liggghts_bench"
 
@@ -292,17 +292,12 @@ def _run(args, cwd, timeout=3600, info=None):
 def _packing():
     """The settled packing as a data file; built once (on 2 processes), reused afterwards."""
     script = MAKE_PACKING.format(settle=SETTLE, out="{out}")
-    key = hashlib.sha1(script.encode()).hexdigest()[:12]
-    data = CACHE / f"packing-{key}.data"
-    if data.is_file():
-        return data
-    CACHE.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=CACHE) as tmp:
-        tmp = Path(tmp)
+
+    def make(tmp):
         (tmp / "in.packing").write_text(script.format(out="packing.data"))
         _run(["mpirun", "-np", "2", str(LAUNCHER), "-in", "in.packing", "-log", "log.packing"], tmp)
-        os.replace(tmp / "packing.data", data)
-    return data
+        return tmp / "packing.data"
+    return cached_data(CACHE, "packing", script, make)
 
 
 def _history_values(tang, extra, work):
@@ -670,7 +665,7 @@ def _table(rows):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m stickslip.adapters.liggghts_bench",
+    ap = argparse.ArgumentParser(prog="python -m stickslip.bench.liggghts",
                                  description="LIGGGHTS stick_slip plugin: overhead vs stock history (time in "
                                              "interleaved rounds, callgrind instructions), MPI speed-up.")
     ap.add_argument("--rounds", type=int, default=ROUNDS,

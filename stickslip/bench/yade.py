@@ -8,7 +8,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from .yade import RUNNER, scene_dict
+from ..adapters.yade import RUNNER, scene_dict
 
 
 def _bench(args):

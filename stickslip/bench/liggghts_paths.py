@@ -15,7 +15,7 @@ liggghts_bench (issue 32), next to stock `tangential history` on the same contac
 
 Cost: the analysis build once (~3-5 min on 2 cores), then ~2 min.
 
-    python -m stickslip.adapters.liggghts_paths [--steps 100]
+    python -m stickslip.bench.liggghts_paths [--steps 100]
 """
 from __future__ import annotations
 
@@ -28,9 +28,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-from .. import callgrind
-from . import liggghts_bench as bench
-from .liggghts import BUILD, LAUNCHER
+from ..adapters.liggghts import BUILD, LAUNCHER
+from . import callgrind
+from . import liggghts as bench
 
 PATHS_BUILD = BUILD.parent / "liggghts_plugin_paths"
 LAW = re.compile(r"ContactModels::TangentialModel<\d+>::(surfacesIntersect|law<)|ContactModels::StickSlip::")
@@ -118,7 +118,7 @@ def stock_attribution(groups, walls):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m stickslip.adapters.liggghts_paths", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m stickslip.bench.liggghts_paths", description=__doc__.split("\n\n")[0])
     ap.add_argument("--steps", type=int, default=bench.CALLGRIND_STEPS, help="steps of the window after the warm-up")
     ap.add_argument("--launcher", type=Path, default=LAUNCHER,
                     help="the build whose instructions are counted (default: the plugin's build; the paths are "

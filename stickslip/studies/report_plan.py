@@ -10,7 +10,7 @@ import csv
 import math
 
 from . import friction_speed, precision, thresholds
-from . import scene as scene_mod
+from .. import scene as scene_mod
 
 # The engines run each ladder from the scene's dt up (factors >= 1); pyref, the reference,
 # runs it all. Below the scene's dt an engine's error is pyref's (the engine tests hold

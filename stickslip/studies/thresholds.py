@@ -18,8 +18,8 @@ import numpy as np
 
 from pyref.laws import every_step_slips_speed
 
-from . import parallel, plotstyle, runner
-from . import scene as scene_mod
+from .. import parallel, plotstyle, runner
+from .. import scene as scene_mod
 
 DTS = (1e-6, 4e-6, 1.6e-5)
 NU_S = (0.0, 33.10, 100.0)

@@ -1,0 +1,275 @@
+"""Adapter for DEM-Engine (PyPI `deme`, Project Chrono's GPU DEM) with the force model of
+deme_model/ (the law in deme_model/stick_slip.cu, attached by deme_model/stickslip_deme.py).
+
+Runs in this process on the GPU: one DEMSolver per scene, the law with the linear normal
+force (the paper's Table 2), the scene's slip timing and reset, and its record on (each
+body's last contact kept in owner wildcards, read after every output row). DEM-Engine is
+3D: 2D scenes run as "equivalent spheres" (docs/law.md, 2D: a sphere of the disk's mass per
+unit thickness, motion held in the xy-plane by a prescribed vz = 0), rotation off as a
+prescribed zero spin, imposed velocity components as prescribed ones. Walls are analytical
+planes: fixed, or turned about their pivot with the angle of each step prescribed (pyref's,
+Scene.rotation_steps and rotation_rate) and its rate as the plane's spin.
+
+What differs from the CPU engines (deme_model/README.md): float arithmetic, positions kept
+on the engine's grid (its box / 2^37 per axis), the first step loads the spring (no set-up
+evaluation: row 0 has zero contact forces, as LIGGGHTS'), the velocity reported is the
+step's (v(t + dt/2)), and sums of many contact forces in an order that changes from run to
+run (a one-grain scene has one contact: none). Supported: stick_slip scenes whose recorded
+contacts are each the only contact of their first grain at a time (the record is per body),
+fixed or turning plane walls, no output.stats, output.slip_stats, output.energy, turning
+gravity, or spin in 2D.
+"""
+from __future__ import annotations
+
+import importlib.util
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .. import columns
+from . import RunResult
+
+NAME = "deme"
+REPO = Path(__file__).resolve().parents[2]
+MODEL_DIR = REPO / "deme_model"
+GRAIN_FAMILY0 = 1  # grain k is family 1 + k
+WALL_FAMILY0 = 200  # wall k is family 200 + k
+MAX_GRAINS = GRAIN_FAMILY0 + WALL_FAMILY0 - 2 - 1  # (families are 8-bit; the engine keeps 255)
+
+
+def helper():
+    """deme_model/stickslip_deme.py, loaded from its file (the folder is not a package)."""
+    spec = importlib.util.spec_from_file_location("stickslip_deme", MODEL_DIR / "stickslip_deme.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _import_deme():
+    import deme
+
+    return deme
+
+
+def available():
+    if importlib.util.find_spec("deme") is None:
+        return "PyPI package `deme` not installed (pip install -e '.[gpu]' brings deme[cuda12])"
+    import ctypes
+
+    try:
+        ctypes.CDLL("libcuda.so.1")
+    except OSError:
+        return "no CUDA driver (libcuda.so.1 not found): DEM-Engine runs on an NVIDIA GPU only"
+    try:
+        _import_deme()
+    except Exception as e:  # (the wheel's CUDA libraries, a driver too old, ...)
+        return f"`import deme` fails: {str(e).splitlines()[0] if str(e) else type(e).__name__}"
+    if not (MODEL_DIR / "stick_slip.cu").is_file():
+        return f"{MODEL_DIR / 'stick_slip.cu'} missing"
+    return None
+
+
+def check_scene(scene):
+    """ValueError, one line, for what this adapter does not run."""
+    scene.refuse_unsupported("DEM-Engine")
+    if scene.contact.law != "stick_slip":
+        raise ValueError(f"the DEM-Engine force model implements stick_slip only, not {scene.contact.law}")
+    out = scene.output
+    for flag in ("energy", "stats", "slip_stats"):
+        if getattr(out, flag):
+            raise ValueError(f"output.{flag}: the DEM-Engine adapter does not record these columns")
+    if scene.gravity_rate or scene.gravity_spinup[1]:
+        raise ValueError("turning gravity: not supported by the DEM-Engine adapter")
+    if scene.dimension == 2 and scene.effects["rotation"]:
+        raise ValueError("effects.rotation in 2D: the equivalent sphere would need a disk's inertia; "
+                         "the DEM-Engine adapter runs 2D scenes without rotation only")
+    if len(scene.grains) > MAX_GRAINS:
+        raise ValueError(f"{len(scene.grains)} grains: the DEM-Engine adapter gives each grain a family, "
+                         f"at most {MAX_GRAINS}")
+    for w in scene.walls:
+        if np.any(w.velocity != 0):
+            raise ValueError(f"wall {w.name}: a translating wall is not supported by the DEM-Engine adapter")
+    firsts = [a for a, _ in out.contacts]
+    if len(set(firsts)) != len(firsts) or any(a not in {g.name for g in scene.grains} for a in firsts):
+        raise ValueError("output.contacts: the DEM-Engine record keeps one contact per grain; each recorded "
+                         "contact must start with a grain of its own")
+
+
+def _expr(x):
+    return repr(float(x))
+
+
+def domain(scene):
+    """A cube around the grains, its edge a power of 2 (grid positions then exact binary
+    fractions) at least 4x the grains' extent and reach: (lo, hi) per axis."""
+    pos = np.array([g.position for g in scene.grains])
+    reach = max(float(np.linalg.norm(g.velocity)) * scene.duration + 10 * g.radius for g in scene.grains)
+    centre = 0.5 * (pos.min(axis=0) + pos.max(axis=0))
+    half = 4 * (float(np.max(pos.max(axis=0) - pos.min(axis=0))) / 2 + reach)
+    half = 2.0 ** math.ceil(math.log2(max(half, 1e-3)))
+    return [(float(c - half), float(c + half)) for c in centre]
+
+
+def turning_prescription(scene, w):
+    """The turning wall's quaternion code and spin (expressions of the engine's t, the time at
+    the start of the step whose end they set). The engine evaluates them after its force
+    step k (1-based) for step k + 1, which pyref calls step k (its step 0 is the set-up):
+    angle rate dt min(k, steps turning) = rate min(t + dt, stop time), spin while k <= steps
+    turning, i.e. t < (steps - 1/2) dt."""
+    rot, dt = w.rotation, scene.dt
+    n, rate = scene.rotation_steps(w), scene.rotation_rate(w)
+    a = rot.axis / np.linalg.norm(rot.axis)
+    angle = f"(({_expr(rate)}) * fmin((double)t + {_expr(dt)}, {_expr(n * dt)}))"
+    quat = (f"double ss_a = {angle}; double ss_s = sin(0.5 * ss_a); "
+            f"return make_float4((float)({_expr(a[0])} * ss_s), (float)({_expr(a[1])} * ss_s), "
+            f"(float)({_expr(a[2])} * ss_s), (float)cos(0.5 * ss_a));")
+    turning = f"((double)t < {_expr((n - 0.5) * dt)})"
+    spin = [f"({turning} ? {_expr(rate * c)} : 0.0)" for c in a]
+    return quat, spin
+
+
+def new_solver(deme):
+    """A solver on the first GPU, quiet but for errors (DEM-Engine 3 takes the list of
+    devices; earlier versions a count)."""
+    try:
+        solver = deme.DEMSolver([0])
+    except TypeError:
+        solver = deme.DEMSolver()
+    solver.SetVerbosity("ERROR")
+    return solver
+
+
+def wall_angle(scene, w, step):
+    """A wall's angle after `step` steps (0 for a fixed one): rate dt min(step, steps turning)."""
+    if w.rotation is None:
+        return 0.0
+    return scene.rotation_rate(w) * scene.dt * min(step, scene.rotation_steps(w))
+
+
+def build(scene, deme):
+    """The solver for a checked scene, not yet initialised: (solver, {grain name: (tracker,
+    family)}). The force model: stickslip_deme.attach(normal="hooke", record=True)."""
+    ss = helper()
+    c, eff = scene.contact, scene.effects
+    p = c.law_params(eff)
+    solver = new_solver(deme)
+    ss.attach(solver, normal="hooke", slip_timing=c.slip_timing, reset=c.reset, record=True)
+    mat = solver.LoadMaterial({"kn": p.kn, "nu_n": p.nu_n, "ks": p.ks, "nu_s": p.nu_s, "mu": p.mu_s, "mu_k": p.mu_k})
+    box = domain(scene)
+    solver.InstructBoxDomainDimension(*box)
+    solver.InstructBoxDomainBoundingBC("none", mat)
+    g3 = [float(v) for v in scene.gravity[:3]] if eff["gravity"] else [0.0, 0.0, 0.0]
+    solver.SetGravitationalAcceleration(g3)
+    grains = {}
+    for k, g in enumerate(scene.grains):
+        fam = GRAIN_FAMILY0 + k
+        template = solver.LoadSphereType(scene.grain_mass(g), g.radius, mat)
+        batch = solver.AddClumps(template, [[float(v) for v in g.position[:3]]])
+        batch.SetVel([[float(v) for v in g.velocity[:3]]])
+        batch.SetFamily(fam)
+        if g.fixed:
+            solver.SetFamilyFixed(fam)
+        else:
+            vel = [(_expr(g.velocity[i]) if a in g.imposed else "none") for i, a in enumerate("xyz")]
+            if scene.dimension == 2:
+                vel[2] = "0"
+            if any(v != "none" for v in vel):
+                solver.SetFamilyPrescribedLinVel(fam, *vel, False)
+            if not eff["rotation"]:
+                solver.SetFamilyPrescribedAngVel(fam, "0", "0", "0", False)  # the paper's no rolling
+        grains[g.name] = (solver.Track(batch), fam)
+    for k, w in enumerate(scene.walls):
+        fam = WALL_FAMILY0 + k
+        obj = solver.AddExternalObject()
+        pivot = w.rotation.pivot if w.rotation is not None else np.zeros(3)
+        obj.AddPlane([float(v) for v in (w.point - pivot)[:3]], [float(v) for v in w.normal[:3]], mat)
+        obj.SetInitPos([float(v) for v in pivot[:3]])
+        obj.SetMass(1.0)
+        obj.SetFamily(fam)
+        if w.rotation is None:
+            solver.SetFamilyFixed(fam)
+        else:
+            quat, spin = turning_prescription(scene, w)
+            solver.SetFamilyPrescribedPosition(fam, *[_expr(v) for v in pivot[:3]])
+            solver.SetFamilyPrescribedQuaternion(fam, quat)
+            solver.SetFamilyPrescribedAngVel(fam, *spin)
+    solver.SetTimeStepSize(scene.dt)
+    solver.SetIntegrator("centered_difference")  # v(t + dt/2) = v + dt a, x += dt v(t + dt/2): leapfrog
+    return solver, grains
+
+
+def steps_duration(n, dt):
+    """The duration to ask DoDynamics for n steps: the engine steps while its elapsed time,
+    summed in its float time step (float(dt) differs from dt by up to 2^-24 relatively), is
+    below the duration, so n dt may give n + 1 steps; (n - 1/2) dt gives n."""
+    return (n - 0.5) * dt
+
+
+def _record(solver, fam, ss):
+    return ss.read_record(solver, fam)
+
+
+def run(scene, out_dir, progress=None):
+    check_scene(scene)
+    deme = _import_deme()
+    ss = helper()
+    t0 = time.perf_counter()
+    solver, grains = build(scene, deme)
+    solver.Initialize()  # (compiles the kernels: minutes on a cold cache, deme_model/README.md)
+    t_init = time.perf_counter() - t0
+    out, d, dt, every = scene.output, scene.dimension, scene.dt, scene.output.every
+    rows = scene.steps // every
+    t = np.arange(rows + 1) * every * dt
+    x = np.zeros((rows + 1, len(out.grains), d))
+    v = np.zeros_like(x)
+    fn = np.zeros((rows + 1, len(out.contacts)))
+    ft = np.zeros((rows + 1, len(out.contacts), d))
+    slips = np.zeros((rows + 1, len(out.contacts)), dtype=int)
+    last_count = np.zeros(len(out.contacts))
+    # the recorded walls' angles: as prescribed (turning_prescription), pyref's of each step
+    turning = [next(w for w in scene.walls if w.name == name) for name in out.walls]
+    angle = np.array([[wall_angle(scene, w, r * every) for w in turning] for r in range(rows + 1)]).reshape(
+        rows + 1, len(turning))
+
+    def sample(r, step):
+        for i, name in enumerate(out.grains):
+            tracker, _ = grains[name]
+            x[r, i] = np.asarray(tracker.Pos(), float)[:d]
+            v[r, i] = np.asarray(tracker.Vel(), float)[:d]
+        for i, (a, _) in enumerate(out.contacts):
+            if r == 0:
+                continue  # no force evaluated yet (row 0: zero contact forces)
+            rec = _record(solver, grains[a][1], ss)
+            # evaluated in the last step (it began at (step - 1) dt): else not touching
+            if rec["t"] >= (step - 1.5) * dt:
+                fn[r, i] = rec["fn"]
+                ft[r, i] = [rec["fx"], rec["fy"], rec["fz"]][:d]
+                count = rec["slips"]
+                slips[r, i] = count - last_count[i] if count >= last_count[i] else count  # (made again)
+                last_count[i] = count
+            else:
+                last_count[i] = 0.0
+
+    t1 = time.perf_counter()
+    sample(0, 0)
+    for r in range(1, rows + 1):
+        solver.DoDynamicsThenSync(steps_duration(every, dt))
+        sample(r, r * every)
+        if progress is not None and (r % max(1, rows // 200) == 0 or r == rows):
+            progress(r * every, scene.steps)
+    wall = time.perf_counter() - t1
+    for arr in (x, v, fn, ft):
+        if not np.isfinite(arr).all():
+            raise RuntimeError("DEM-Engine: a non-finite position, velocity or contact force")
+    rec = _Recording(t, x, v, fn, ft, slips, angle)
+    notes = [f"DEM-Engine: {t_init:.0f} s to initialise (JIT compile), {wall:.1f} s to run; float arithmetic"]
+    return RunResult(columns.frame(scene, rec), scene.steps, wall, notes)
+
+
+class _Recording:
+    """The fields columns.frame reads (pyref.Recording's names)."""
+
+    def __init__(self, t, x, v, fn, ft, slips, angle):
+        self.t, self.x, self.v, self.fn, self.ft, self.slips, self.angle = t, x, v, fn, ft, slips, angle
