@@ -2,7 +2,7 @@
 
 run -> runner.py, report -> report.py, bench -> bench/table.py, precision, thresholds,
 drum-study and drum-engines -> studies/precision.py, thresholds.py, drum_study.py,
-drum_engines.py. Bad arguments or a bad scene: one line on
+drum_engines.py; study-3d and calibrate -> studies/granular3d.py, calibrate.py. Bad arguments or a bad scene: one line on
 stderr, exit status 2; an engine that fails, a file that cannot be written, or a fault of
 ours: one line, exit status 1 (STICKSLIP_TRACEBACK=1 shows the traceback of a fault).
 """
@@ -45,6 +45,16 @@ def _count(text):
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
     if not 1 <= v <= 100:
         raise argparse.ArgumentTypeError(f"{text!r} must be in [1, 100]")
+    return v
+
+
+def _angle(text):
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not 0 < v < 90:
+        raise argparse.ArgumentTypeError(f"{text!r} must be an angle in degrees, in (0, 90)")
     return v
 
 
@@ -130,6 +140,35 @@ def build_parser():
     de.add_argument("--parts", nargs="+", choices=("costs", "divergence", "statistics"),
                     default=["costs", "divergence", "statistics"], help="which parts to run (default: all)")
     de.add_argument("--quiet", action="store_true", help="no progress bars")
+
+    g3 = sub.add_parser("study-3d", help="what mu_s and mu_k do to a bed of spheres: incline and heap, history vs "
+                                          "stick-slip, on LIGGGHTS and LAMMPS (docs/granular-3d.md); resumes")
+    g3.add_argument("--out", type=_folder, default=Path("docs/granular-3d"),
+                    help="tables, figures and summary (default: docs/granular-3d)")
+    g3.add_argument("--runs", type=_folder, default=Path("runs/granular3d"),
+                    help="the runs, kept for resuming (default: runs/granular3d)")
+    g3.add_argument("--fills", type=_count, default=3, help="fills (random beds) per point (default: 3)")
+    g3.add_argument("--only", nargs="+", help="run only the runs whose label holds one of these strings")
+    g3.add_argument("--no-checks", action="store_true", help="leave out the set-up's checks (deep bed, half "
+                                                              "rates, Silbert's kn)")
+    g3.add_argument("--engines", nargs="+", choices=("liggghts", "lammps"), default=["liggghts", "lammps"],
+                    help="LAMMPS repeats the validation and two stick-slip points (default: both)")
+    g3.add_argument("--jobs", type=_count, default=2, help="runs side by side (default: 2)")
+    g3.add_argument("--tables-only", action="store_true", help="tables and figures of the runs on disk; run nothing")
+    g3.add_argument("--from-csv", action="store_true",
+                    help="redraw the tables, figures and summary from OUT/runs.csv alone (the committed results)")
+    g3.add_argument("--smoke", action="store_true", help="a study of a few seconds on small scenes (the test suite's)")
+    g3.add_argument("--keep-engine-files", action="store_true", help="keep each run's dumps (megabytes a run)")
+    g3.add_argument("--quiet", action="store_true", help="no progress bar")
+
+    cal = sub.add_parser("calibrate", help="mu_s and mu_k for target angles of a bed of spheres, from the measured "
+                                           "map of study-3d (docs/granular-3d.md)")
+    cal.add_argument("--theta-start", type=_angle, help="angle at which a bed starts to flow, deg")
+    cal.add_argument("--theta-stop", type=_angle, help="angle at which a flowing bed stops, deg")
+    cal.add_argument("--theta-heap", type=_angle, help="angle of repose of a heap on a plate, deg")
+    cal.add_argument("--rolling", type=float, default=0.0, help="rolling resistance coefficient (epsd2) of the "
+                                                                 "material (default: 0)")
+    cal.add_argument("--map", type=Path, help="the measured map, points.csv (default: docs/granular-3d/points.csv)")
 
     rep = sub.add_parser("report", help="run the paper's cases on every available engine; figures + report.md")
     rep.add_argument("--out", type=_folder, default=Path("report"), help="output folder (default: report)")
@@ -252,6 +291,29 @@ def cmd_drum_engines(args):
     return 0
 
 
+def cmd_study_3d(args):
+    from .studies import granular3d, granular3d_tables
+
+    if args.from_csv:
+        if not (args.out / "runs.csv").is_file():
+            raise SceneError(f"--from-csv: {args.out / 'runs.csv'} not found (run the study first)")
+        granular3d_tables.write_tables(args.out)
+        return 0
+    smoke = {"jobs": granular3d.smoke_jobs(), "scenes": granular3d.SMOKE_SCENES} if args.smoke else {}
+    granular3d.run_study(args.out, args.runs, fills=tuple(range(1, args.fills + 1)), checks=not args.no_checks,
+                         engines=tuple(args.engines), only=args.only, jobs_at_once=args.jobs,
+                         progress=not args.quiet, tables_only=args.tables_only,
+                         keep_engine_files=args.keep_engine_files, **smoke)
+    return 0
+
+
+def cmd_calibrate(args):
+    from .studies import calibrate
+
+    calibrate.main(args)
+    return 0
+
+
 def cmd_report(args):
     from .report import build_report
     from .runner import prepare_output
@@ -261,7 +323,7 @@ def cmd_report(args):
 
 
 COMMANDS = {"run": cmd_run, "precision": cmd_precision, "thresholds": cmd_thresholds, "bench": cmd_bench,
-            "report": cmd_report, "drum-study": cmd_drum_study,
+            "report": cmd_report, "drum-study": cmd_drum_study, "study-3d": cmd_study_3d, "calibrate": cmd_calibrate,
             "drum-engines": cmd_drum_engines}
 
 if __name__ == "__main__":

@@ -253,14 +253,14 @@ def check_periodic(periodic, grains, walls):
     r = np.array([g.radius for g in grains])
     for axis, (lo, hi) in periodic.items():
         k = "xyz".index(axis)
+        if hi - lo <= 4 * r.max():
+            raise SceneError(f"periodic.{axis} = [{lo:g}, {hi:g}]: must be longer than two largest diameters "
+                             f"({4 * r.max():.3g} m): a grain would touch its own image")
         out = np.flatnonzero((x[:, k] < lo) | (x[:, k] >= hi))
         if len(out):
             g = grains[out[0]]
             raise SceneError(f"grain {g.name!r} starts at {axis} = {g.position[k]:.6g}, outside the periodic box "
                              f"periodic.{axis} = [{lo:g}, {hi:g})")
-        if hi - lo <= 4 * r.max():
-            raise SceneError(f"periodic.{axis} = [{lo:g}, {hi:g}]: must be longer than two largest diameters "
-                             f"({4 * r.max():.3g} m): a grain would touch its own image")
         for w in walls:
             if abs(w.normal[k]) > 1e-12:
                 raise SceneError(f"wall {w.name!r}: its normal has a part along the periodic axis {axis} (a plane "

@@ -418,7 +418,7 @@ def _gravity_ramp(top: Table, dim, effects, gravity, gravity_rate):
     axis = rt.vector("axis", 3, required=True)
     g = gravity / np.linalg.norm(gravity)
     if np.linalg.norm(axis) == 0 or abs(float(axis @ g)) > 1e-9 * np.linalg.norm(axis):
-        raise SceneError(f"gravity_ramp.axis = {shown(list(axis))}: must be a non-zero vector perpendicular to "
+        raise SceneError(f"gravity_ramp.axis = {shown([float(a) for a in axis])}: must be a non-zero vector perpendicular to "
                          "gravity (gravity turns about it)")
     max_angle = rt.number("max_angle", 90.0, lo=0, lo_open=True, hi=180.0)
     phases = []

@@ -1,0 +1,263 @@
+"""`stickslip study-3d`: what mu_s and mu_k each do to a bed of spheres (issue 39; the
+findings: docs/granular-3d.md).
+
+The matrix: cases/incline3d.toml (theta_start, theta_stop) and cases/heap3d.toml
+(theta_heap) with stock history at MUS and with the stick-slip PAIRS, rolling resistance
+off and on, FILLS fills each (the base's and the bed's random seeds), on LIGGGHTS; the
+checks of the set-up (a 20 d deep bed against Weinhart et al.'s h_stop, the ramp at half
+its rates, Silbert et al.'s stiffer contact); LAMMPS on the validation and two stick-slip
+points. The cost is stated before the first run starts (COST, measured); each finished
+run stays on disk under `runs/<label>/` (summary.json and a small CSV: the ramp's series or
+the heap's profile) and an interrupted study resumes with the runs it has not finished.
+Then granular3d_tables.py writes the tables, figures and summary under `--out`.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import sys
+import time
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .. import runner
+from ..errors import SceneError
+from ..kinds import heap3d, incline3d
+from ..scene import find, parse
+
+# Stock history: stick_slip with mu_k = mu_s and no tangential dashpot (a slip caps the force
+# at mu Fn: docs/law.md). The range DEM users work in.
+MUS = (0.2, 0.35, 0.5, 0.8)
+# Stick-slip (mu_s, mu_k): mu_s and 2 mu_k - mu_s vary independently, and both land on MUS
+# (2 mu_k - mu_s = 0.2, 0.5, 0.2, 0.35): each prediction is a measured history point.
+PAIRS = ((0.8, 0.5), (0.8, 0.65), (0.5, 0.35), (0.5, 0.425))
+# The paper's nu_s, as a share of nu_n: Table 2's 33.10 / 41.38 = 0.8. The scenes' nu_n
+# (restitution 0.88) makes it 6.325 m sqrt(g/d).
+NU_S_OVER_NU_N = 33.10 / 41.38
+ROLLING = (0.0, 0.1)  # coefficientRollingFriction of LIGGGHTS' epsd2 (0: none)
+FILLS = (1, 2, 3)
+# The pair that also runs with exact slip timing (the paper's nu_s), and the two stick-slip
+# points LAMMPS repeats.
+EXACT_PAIR = (0.8, 0.5)
+LAMMPS_PAIRS = ((0.8, 0.5), (0.5, 0.35))
+# A deeper bed for the validation: H = 20 d (Weinhart et al.'s fit: theta_stop ~ 20.2 deg).
+DEEP_LAYERS = 36
+# Silbert et al.'s own contact for the stiffness check: kn = 2e5 m g/d, gamma_n = 50
+# sqrt(g/d) (nu_n = 25 for a pair of m/2), dt = 1e-4 sqrt(d/g).
+SILBERT = {"kn": 2.0e5, "ks": 2.0e5 * 2 / 7, "nu_n": 25.0, "dt": 1e-4}
+
+# What a run costs, CPU seconds per grain-step (one LIGGGHTS process, 2 running at once on
+# the 2-core machine; LAMMPS measured on the same scenes), and the simulated time a run of
+# each kind lasts (the incline's ramp ends it; heap: the scene's duration). Measured on the
+# study's own runs (docs/granular-3d.md, "Cost"); only to say beforehand what a study costs.
+SECONDS_PER_GRAIN_STEP = {"liggghts": 1.6e-7, "lammps": 1.3e-7}
+INCLINE_TIME = 330.0  # time units: the ramp of a 10 d bed at the scene's rates
+
+
+@dataclass
+class Job:
+    """One run of the study: its folder label, the scene file, what changes in it, the engine."""
+    label: str
+    kind: str  # "incline" | "heap"
+    engine: str
+    group: str  # "sweep" | "validation" | "check" | "engines"
+    material: str  # history_0.50 | ss_0.80_0.50 ...
+    mu_s: float
+    mu_k: float
+    nu_s: str  # "0" | "paper"
+    timing: str
+    rolling: float
+    fill: int
+    layers: int | None = None  # the incline's lattice layers (None: the scene's)
+    rate_factor: float = 1.0
+    silbert: bool = False
+    data: dict = field(default_factory=dict)
+
+
+def material_label(mu_s, mu_k):
+    return f"history_{mu_s:.2f}" if mu_s == mu_k else f"ss_{mu_s:.2f}_{mu_k:.3g}"
+
+
+def _jobs_of(kind, engine, group, mu_s, mu_k, nu_s, timing, rolling, fills, **more):
+    out = []
+    for fill in fills:
+        mat = material_label(mu_s, mu_k)
+        variant = "" if mu_s == mu_k else f"_nus{nu_s}_{timing}"
+        extra = "".join(f"_{k}{v}" for k, v in sorted(more.items()) if k in ("layers", "rate_factor") and v) + (
+            "_silbert" if more.get("silbert") else "")
+        label = f"{kind}_{engine}_{mat}{variant}_roll{rolling:g}{extra}_fill{fill}"
+        out.append(Job(label, kind, engine, group, mat, mu_s, mu_k, nu_s, timing, rolling, fill, **more))
+    return out
+
+
+def matrix(fills=FILLS, checks=True, engines=("liggghts", "lammps")):
+    """Every run of the study, the sweep first."""
+    jobs = []
+    for kind in ("incline", "heap"):
+        for rolling in ROLLING:
+            for mu in MUS:
+                jobs += _jobs_of(kind, "liggghts", "sweep", mu, mu, "0", "step", rolling, fills)
+            for mu_s, mu_k in PAIRS:
+                jobs += _jobs_of(kind, "liggghts", "sweep", mu_s, mu_k, "paper", "step", rolling, fills)
+                # without the dashpot the step mode slips at every step above V* (docs/law.md):
+                # nu_s = 0 runs in the exact mode, as the drum's did
+                jobs += _jobs_of(kind, "liggghts", "sweep", mu_s, mu_k, "0", "exact", rolling, fills)
+            jobs += _jobs_of(kind, "liggghts", "sweep", *EXACT_PAIR, "paper", "exact", rolling, fills)
+    if checks:
+        jobs += _jobs_of("incline", "liggghts", "validation", 0.5, 0.5, "0", "step", 0.0, fills, layers=DEEP_LAYERS)
+        jobs += _jobs_of("incline", "liggghts", "check", 0.5, 0.5, "0", "step", 0.0, fills, rate_factor=0.5)
+        jobs += _jobs_of("incline", "liggghts", "check", 0.5, 0.5, "0", "step", 0.0, fills, silbert=True)
+    if "lammps" in engines:
+        jobs += _jobs_of("incline", "lammps", "validation", 0.5, 0.5, "0", "step", 0.0, fills)
+        jobs += _jobs_of("incline", "lammps", "validation", 0.5, 0.5, "0", "step", 0.0, fills, layers=DEEP_LAYERS)
+        for mu_s, mu_k in LAMMPS_PAIRS:
+            jobs += _jobs_of("incline", "lammps", "engines", mu_s, mu_k, "paper", "step", 0.0, fills)
+    return jobs
+
+
+SCENES = {"incline": "incline3d", "heap": "heap3d"}
+
+
+def scene_data(job, base):
+    """The scene's TOML data with the job's settings written in."""
+    data = json.loads(json.dumps(base))
+    c = data["contact"]
+    c.update(mu_s=job.mu_s, mu_k=job.mu_k, slip_timing=job.timing)
+    if job.silbert:
+        c.update(kn=SILBERT["kn"], ks=SILBERT["ks"], nu_n=SILBERT["nu_n"])
+        every_time = data["output"]["every"] * data["time"]["dt"]
+        data["time"]["dt"] = SILBERT["dt"]
+        data["output"]["every"] = int(round(every_time / SILBERT["dt"]))
+    c["nu_s"] = NU_S_OVER_NU_N * c["nu_n"] if job.nu_s == "paper" else 0.0
+    data["effects"]["tangential_damping"] = c["nu_s"] > 0
+    if job.rolling:
+        c.update(rolling="epsd2", rolling_mu=job.rolling)
+    for block in data.get("base", []) + data.get("lattice", []):
+        block["seed"] = job.fill
+    if job.layers:
+        data["lattice"][0]["counts"][2] = job.layers
+        data["time"]["duration"] *= job.layers / base["lattice"][0]["counts"][2]
+    if job.rate_factor != 1.0:
+        for ph in data["gravity_ramp"]["phase"]:
+            ph["rate"] *= job.rate_factor
+        data["time"]["duration"] /= job.rate_factor
+    data["name"] = f"{base['name']}_{job.label}"
+    return data
+
+
+def plan(jobs, out_runs, scenes=None):
+    """[(job, scene, data, folder)], every scene checked before any run starts."""
+    bases = {k: tomllib.loads(find(v).read_text()) for k, v in (scenes or SCENES).items()}
+    paths = {k: find(v) for k, v in (scenes or SCENES).items()}
+    out = []
+    for job in jobs:
+        data = scene_data(job, bases[job.kind])
+        try:
+            sc = parse(data, source=paths[job.kind])
+        except SceneError as e:
+            raise SceneError(f"run {job.label}: {e}") from None
+        out.append((job, sc, data, Path(out_runs) / job.label))
+    return out
+
+
+def estimate(job, sc):
+    """CPU seconds a run takes (SECONDS_PER_GRAIN_STEP, INCLINE_TIME), only to say beforehand."""
+    if job.kind == "incline":
+        layers = job.layers or 18
+        sim = INCLINE_TIME * (layers / 18) ** 0.5 / job.rate_factor
+    else:
+        sim = sc.duration
+    return SECONDS_PER_GRAIN_STEP[job.engine] * len(sc.grains) * sim / sc.dt
+
+
+def _record(data, engine):
+    return {"engine": engine, "scene": {k: v for k, v in data.items() if k != "description"}}
+
+
+def done(folder, data, engine):
+    """A run is finished when its summary is on disk for the same engine and scene."""
+    try:
+        return (json.loads((folder / "settings.json").read_text()) == json.loads(json.dumps(_record(data, engine)))
+                and (folder / "summary.json").is_file())
+    except (OSError, ValueError):
+        return False
+
+
+def run_one(job, sc, data, folder, keep_engine_files=False):
+    """Run one job unless it is on disk: its summary, and a small CSV (the incline's ramp
+    series; the heap's surface profile). Written to <folder>.part and renamed when whole,
+    so an interruption loses no finished run and leaves no half one that looks finished."""
+    if done(folder, data, job.engine):
+        return False
+    tmp = folder.with_name(folder.name + ".part")
+    if tmp.exists():
+        shutil.rmtree(tmp)
+    summary, df = runner.run_scene(sc, job.engine, tmp, progress=False, write_timeseries=False)
+    if job.kind == "incline":
+        keep = df[["t", "tilt", "phase", "com_z", "vcm_x", "vcm_y", "vcm_z", "ekin"]].copy()
+        keep.insert(3, "speed", incline3d.downhill_speed(sc, df))
+        keep.to_csv(tmp / "series.csv", index=False)
+    else:
+        xc, top = heap3d.profile(sc, df.iloc[-1])
+        np.savetxt(tmp / "profile.csv", np.column_stack([xc, top]), delimiter=",", header="x,height", comments="")
+    (tmp / "settings.json").write_text(json.dumps(_record(data, job.engine), indent=1))
+    if not keep_engine_files:  # dumps of every grain: megabytes a run
+        shutil.rmtree(tmp / job.engine, ignore_errors=True)
+    if folder.exists():
+        shutil.rmtree(folder)
+    os.replace(tmp, folder)
+    return True
+
+
+def _task(job, sc, data, folder, keep):
+    """A task for parallel.run_all: the run, then its summary read back."""
+    run_one(job, sc, data, folder, keep)
+    return json.loads((folder / "summary.json").read_text())
+
+
+def run_study(out, out_runs, fills=FILLS, checks=True, engines=("liggghts", "lammps"), only=None, jobs_at_once=2,
+              progress=True, tables_only=False, keep_engine_files=False, jobs=None, scenes=None):
+    """The matrix (or `jobs`): the cost said first, `jobs_at_once` runs side by side, a line
+    per finished run, then the tables and figures of every finished run."""
+    from . import granular3d_tables
+    from .. import parallel
+
+    jobs = jobs if jobs is not None else matrix(fills, checks, engines)
+    if only:
+        jobs = [j for j in jobs if any(s in j.label for s in only)]
+        if not jobs:
+            raise SceneError(f"--only {' '.join(only)}: matches no run of the study")
+    planned = plan(jobs, out_runs, scenes)
+    todo = [p for p in planned if not done(p[3], p[2], p[0].engine)]
+    if not tables_only and todo:
+        cost = {p[0].label: estimate(p[0], p[1]) for p in todo}
+        say = sys.stderr.write
+        say(f"stickslip study-3d: {len(planned)} runs, {len(planned) - len(todo)} already on disk in {out_runs}; "
+            f"{len(todo)} to run ({jobs_at_once} at once), about {sum(cost.values()) / 60 / jobs_at_once:.0f} min "
+            f"({sum(cost.values()) / 3600:.1f} CPU hours)\n")
+        t0 = time.perf_counter()
+        tasks = [(cost[j.label], _task, (j, sc, data, folder, keep_engine_files)) for j, sc, data, folder in todo]
+        results = parallel.run_all(tasks, "study-3d", progress, n_workers=jobs_at_once)
+        failed = [(t[2][0].label, r) for t, r in zip(tasks, results) if isinstance(r, Exception)]
+        say(f"stickslip study-3d: {len(todo) - len(failed)} runs finished in {(time.perf_counter() - t0) / 60:.1f} "
+            "min" + (f"; {len(failed)} failed, first: {failed[0][0]}: {failed[0][1]}" if failed else "") + "\n")
+    finished = [p for p in planned if done(p[3], p[2], p[0].engine)]
+    return granular3d_tables.write_runs(finished, Path(out))
+
+
+# The smoke study (the test suite, `study-3d --smoke`): small scenes, two materials, one fill.
+SMOKE_SCENES = {"incline": "incline3d_small", "heap": "heap3d_small"}
+
+
+def smoke_jobs():
+    """A study of a few seconds: history and one stick-slip pair on the small incline,
+    history on the small heap."""
+    return (_jobs_of("incline", "liggghts", "sweep", 0.5, 0.5, "0", "step", 0.0, (1,))
+            + _jobs_of("incline", "liggghts", "sweep", 0.5, 0.35, "paper", "step", 0.0, (1,))
+            + _jobs_of("heap", "liggghts", "sweep", 0.5, 0.5, "0", "step", 0.0, (1,)))
+

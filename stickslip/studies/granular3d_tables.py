@@ -1,0 +1,305 @@
+"""The tables, tests of the predictions, figures and summary of `stickslip study-3d`
+(docs/granular-3d.md), all from runs.csv: `write_runs` makes runs.csv from the finished
+runs, `write_tables` everything else from runs.csv alone, so that the committed CSVs
+redraw every figure (`stickslip study-3d --from-csv`).
+
+Means are over fills, with their spread: std (ddof 1) and standard error std/sqrt(n).
+A prediction "X falls on the stock curve at mu" is tested by z = (X - curve(mu)) /
+sqrt(se_X^2 + se_curve^2), the curve being stock history's mean at that mu (every mu the
+predictions need is a measured one: granular3d.PAIRS; others are interpolated linearly,
+with the standard errors of the two neighbours interpolated alike).
+"""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import granular3d as g3
+
+ANGLES = ("theta_start", "theta_stop", "theta_heap")
+# Weinhart et al. (2012, Granular Matter 14, 531), their fit of h_stop for a base of fixed
+# spheres of the flowing ones' size: h_stop = A d (tan d2 - tan theta) / (tan theta - tan d1).
+WEINHART = {"A": 3.836, "delta1": 17.561, "delta2": 32.257}
+VALIDATION_TOLERANCE = 0.7  # degrees (issue 39)
+KEYS = ["kind", "engine", "group", "material", "mu_s", "mu_k", "nu_s", "timing", "rolling", "layers",
+        "rate_factor", "silbert"]
+
+
+def weinhart_theta_stop(depth):
+    """The angle (deg) at which Weinhart et al.'s fit puts h_stop = depth (in d)."""
+    a, t1, t2 = WEINHART["A"], math.tan(math.radians(WEINHART["delta1"])), math.tan(math.radians(WEINHART["delta2"]))
+    return math.degrees(math.atan((a * t2 + depth * t1) / (a + depth)))
+
+
+def write_runs(finished, out):
+    """runs.csv (one row per finished run) from [(job, scene, data, folder)], then the rest."""
+    rows = []
+    for job, sc, _, folder in finished:
+        s = json.loads((folder / "summary.json").read_text())
+        rows.append({"label": job.label, "kind": job.kind, "engine": job.engine, "group": job.group,
+                     "material": job.material, "mu_s": job.mu_s, "mu_k": job.mu_k, "nu_s": job.nu_s,
+                     "timing": job.timing, "rolling": job.rolling, "layers": job.layers or 0,
+                     "rate_factor": job.rate_factor, "silbert": job.silbert, "fill": job.fill,
+                     "grains": len(sc.grains), "dt": sc.dt, "steps": s["steps"], "wall_time_s": s["wall_time_s"],
+                     "theta_start": s.get("theta_start_deg", math.nan), "theta_stop": s.get("theta_stop_deg", math.nan),
+                     "theta_heap": s.get("theta_heap_deg", math.nan), "depth_at_stop": s.get("depth_at_stop", math.nan),
+                     "heap_flank_half_difference": s.get("flank_half_difference_deg", math.nan),
+                     "heap_ekin_per_grain_mgd": s.get("heap_ekin_per_grain_mgd", math.nan)})
+    out.mkdir(parents=True, exist_ok=True)
+    runs = pd.DataFrame(rows)
+    runs.to_csv(out / "runs.csv", index=False)
+    return write_tables(out)
+
+
+def points(runs):
+    """One row per point of the study: the mean, std, se and n of every angle over fills."""
+    runs = runs.copy()
+    for k in ("layers", "rate_factor", "silbert"):
+        runs[k] = runs[k].fillna(0)
+    rows = []
+    for key, grp in runs.groupby(KEYS, sort=False, dropna=False):
+        row = dict(zip(KEYS, key))
+        for a in ANGLES + ("depth_at_stop",):
+            v = grp[a].to_numpy(float)
+            v = v[np.isfinite(v)]
+            row[f"{a}_mean"] = float(v.mean()) if len(v) else math.nan
+            row[f"{a}_std"] = float(v.std(ddof=1)) if len(v) > 1 else math.nan
+            row[f"{a}_se"] = row[f"{a}_std"] / math.sqrt(len(v)) if len(v) > 1 else math.nan
+            row[f"{a}_n"] = len(v)
+        row["fills"] = len(grp)
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def _sweep(pts, kind, rolling):
+    return pts[(pts.kind == kind) & (pts.engine == "liggghts") & (pts.group == "sweep") & (pts["rolling"] == rolling)]
+
+
+def curve(pts, angle, rolling, mu):
+    """Stock history's (mean, se) of `angle` at `mu` (interpolated between measured mus)."""
+    kind = "heap" if angle == "theta_heap" else "incline"
+    h = _sweep(pts, kind, rolling)
+    h = h[h.mu_s == h.mu_k].sort_values("mu_s")
+    m, e = h[f"{angle}_mean"].to_numpy(float), h[f"{angle}_se"].to_numpy(float)
+    x = h["mu_s"].to_numpy(float)
+    if not len(x) or not x.min() - 1e-9 <= mu <= x.max() + 1e-9:
+        return math.nan, math.nan
+    return float(np.interp(mu, x, m)), float(np.interp(mu, x, e))
+
+
+def _z(a, sa, b, sb):
+    s = math.sqrt(sa**2 + sb**2) if np.isfinite(sa) and np.isfinite(sb) else math.nan
+    return (a - b) / s if s and np.isfinite(s) else math.nan
+
+
+def predictions(pts):
+    """Each prediction of issue 39 tested on each stick-slip point: the measured angle, the
+    stock curve's at the predicted mu (and at mu_k, the naive reading), z of each."""
+    rows = []
+    ss = pts[(pts.engine == "liggghts") & (pts.group == "sweep") & (pts.mu_s != pts.mu_k)]
+    tests = (("theta_stop", "2mu_k-mu_s"), ("theta_heap", "2mu_k-mu_s"), ("theta_start", "mu_s"))
+    for _, p in ss.iterrows():
+        for angle, predicted in tests:
+            kind = "heap" if angle == "theta_heap" else "incline"
+            if p.kind != kind:
+                continue
+            mu = 2 * p.mu_k - p.mu_s if predicted == "2mu_k-mu_s" else p.mu_s
+            c, ce = curve(pts, angle, p["rolling"], mu)
+            k, ke = curve(pts, angle, p["rolling"], p.mu_k)
+            m, e = p[f"{angle}_mean"], p[f"{angle}_se"]
+            rows.append({"angle": angle, "material": p.material, "mu_s": p.mu_s, "mu_k": p.mu_k, "nu_s": p.nu_s,
+                         "timing": p.timing, "rolling": p["rolling"], "measured": m, "se": e, "predicted_at": predicted,
+                         "mu_predicted": mu, "stock_at_predicted": c, "stock_se": ce, "z_predicted": _z(m, e, c, ce),
+                         "stock_at_mu_k": k, "z_mu_k": _z(m, e, k, ke)})
+    return pd.DataFrame(rows)
+
+
+def hysteresis(pts):
+    """theta_start - theta_stop against mu_s - mu_k (history at 0), per rolling and variant:
+    the weighted least-squares slope, its standard error and z = slope / se."""
+    inc = pts[(pts.kind == "incline") & (pts.engine == "liggghts") & (pts.group == "sweep")]
+    rows = []
+    for rolling in sorted(inc["rolling"].unique()):
+        for variant in (("paper", "step"), ("0", "exact")):
+            sel = inc[(inc["rolling"] == rolling) & ((inc.mu_s == inc.mu_k) | ((inc.nu_s == variant[0]) &
+                                                                          (inc.timing == variant[1])))]
+            x = (sel.mu_s - sel.mu_k).to_numpy(float)
+            y = (sel.theta_start_mean - sel.theta_stop_mean).to_numpy(float)
+            e = np.hypot(sel.theta_start_se, sel.theta_stop_se).to_numpy(float)
+            ok = np.isfinite(y) & np.isfinite(e) & (e > 0)
+            if ok.sum() < 3:
+                continue
+            w = 1 / e[ok] ** 2
+            a = np.column_stack([np.ones(ok.sum()), x[ok]])
+            cov = np.linalg.inv(a.T @ (a * w[:, None]))
+            coef = cov @ (a.T @ (w * y[ok]))
+            rows.append({"rolling": rolling, "nu_s": variant[0], "timing": variant[1], "points": int(ok.sum()),
+                         "slope_deg_per_unit_mu": coef[1], "slope_se": math.sqrt(cov[1, 1]),
+                         "z": coef[1] / math.sqrt(cov[1, 1]), "intercept_deg": coef[0]})
+    return pd.DataFrame(rows)
+
+
+def rolling_effect(pts):
+    """Does rolling resistance shrink what the law changes? For each pair and variant, the
+    difference from stock history at mu_s, d = X(pair) - stock(mu_s), without and with
+    rolling resistance; z = (|d_0| - |d_r|) / combined se (> 0: shrinks)."""
+    rows = []
+    ss = pts[(pts.engine == "liggghts") & (pts.group == "sweep") & (pts.mu_s != pts.mu_k)]
+    rolls = sorted(ss["rolling"].unique())
+    if len(rolls) < 2:
+        return pd.DataFrame(rows)
+    for angle in ANGLES:
+        kind = "heap" if angle == "theta_heap" else "incline"
+        for (mat, nu_s, timing), grp in ss[ss.kind == kind].groupby(["material", "nu_s", "timing"]):
+            d = {}
+            for _, p in grp.iterrows():
+                c, ce = curve(pts, angle, p["rolling"], p.mu_s)
+                d[p["rolling"]] = (p[f"{angle}_mean"] - c, math.hypot(p[f"{angle}_se"], ce))
+            if rolls[0] in d and rolls[-1] in d:
+                (d0, e0), (d1, e1) = d[rolls[0]], d[rolls[-1]]
+                rows.append({"angle": angle, "material": mat, "nu_s": nu_s, "timing": timing,
+                             f"d_roll{rolls[0]:g}": d0, f"se_roll{rolls[0]:g}": e0,
+                             f"d_roll{rolls[-1]:g}": d1, f"se_roll{rolls[-1]:g}": e1,
+                             "z_shrinks": _z(abs(d0), e0, abs(d1), e1)})
+    return pd.DataFrame(rows)
+
+
+def validation(pts):
+    """theta_stop of stock history mu = 0.5, no rolling resistance, at both depths and on
+    both engines, against Weinhart et al.'s fit at the measured depth."""
+    rows = []
+    h = pts[(pts.kind == "incline") & (pts.material == "history_0.50") & (pts["rolling"] == 0) &
+            (pts.rate_factor == 1) & (~pts.silbert.astype(bool)) & pts.group.isin(["sweep", "validation"])]
+    for _, p in h.iterrows():
+        w = weinhart_theta_stop(p.depth_at_stop_mean)
+        rows.append({"engine": p.engine, "layers": int(p.layers) or 18, "depth_d": p.depth_at_stop_mean,
+                     "theta_stop": p.theta_stop_mean, "std": p.theta_stop_std, "se": p.theta_stop_se,
+                     "fills": p.fills, "weinhart_at_depth": w, "difference": p.theta_stop_mean - w,
+                     "within_0.7": abs(p.theta_stop_mean - w) <= VALIDATION_TOLERANCE})
+    return pd.DataFrame(rows)
+
+
+def checks(pts):
+    """The set-up's checks against the H = 10 d stock run they vary: half rates, Silbert's kn."""
+    rows = []
+    inc = pts[(pts.kind == "incline") & (pts.engine == "liggghts") & (pts.material == "history_0.50") &
+              (pts["rolling"] == 0) & (pts.layers == 0)]
+    ref = inc[(inc.group == "sweep")]
+    if not len(ref):
+        return pd.DataFrame(rows)
+    ref = ref.iloc[0]
+    for what, sel in (("rates halved", inc.rate_factor == 0.5), ("Silbert's kn = 2e5, dt = 1e-4", inc.silbert.astype(bool))):
+        for _, p in inc[sel].iterrows():
+            for a in ("theta_stop", "theta_start"):
+                rows.append({"check": what, "angle": a, "reference": ref[f"{a}_mean"], "reference_se": ref[f"{a}_se"],
+                             "checked": p[f"{a}_mean"], "checked_se": p[f"{a}_se"],
+                             "difference": p[f"{a}_mean"] - ref[f"{a}_mean"],
+                             "z": _z(p[f"{a}_mean"], p[f"{a}_se"], ref[f"{a}_mean"], ref[f"{a}_se"])})
+    return pd.DataFrame(rows)
+
+
+def engines(pts):
+    """LAMMPS against LIGGGHTS on the points both ran: difference and z."""
+    rows = []
+    lam = pts[pts.engine == "lammps"]
+    lig = pts[pts.engine == "liggghts"]
+    for _, p in lam.iterrows():
+        q = lig[(lig.kind == p.kind) & (lig.material == p.material) & (lig.nu_s == p.nu_s) & (lig.timing == p.timing)
+                & (lig["rolling"] == p["rolling"]) & (lig.layers == p.layers) & (lig.rate_factor == 1) & (~lig.silbert.astype(bool))]
+        if not len(q):
+            continue
+        q = q.iloc[0]
+        for a in ("theta_stop", "theta_start"):
+            rows.append({"material": p.material, "nu_s": p.nu_s, "layers": int(p.layers) or 18, "angle": a,
+                         "liggghts": q[f"{a}_mean"], "liggghts_std": q[f"{a}_std"], "lammps": p[f"{a}_mean"],
+                         "lammps_std": p[f"{a}_std"], "difference": p[f"{a}_mean"] - q[f"{a}_mean"],
+                         "z": _z(p[f"{a}_mean"], p[f"{a}_se"], q[f"{a}_mean"], q[f"{a}_se"])})
+    return pd.DataFrame(rows)
+
+
+def cost(runs):
+    """CPU seconds per grain-step of each engine and kind, measured on the study's runs
+    (the engine's own loop time; 2 runs at once on the 2-core machine)."""
+    rows = []
+    for (engine, kind), grp in runs.groupby(["engine", "kind"]):
+        gs = (grp.grains * grp.steps).to_numpy(float)
+        rows.append({"engine": engine, "kind": kind, "runs": len(grp), "wall_s_total": grp.wall_time_s.sum(),
+                     "seconds_per_grain_step": grp.wall_time_s.sum() / gs.sum(),
+                     "mean_simulated_time": float((grp.steps * grp.dt).mean())})
+    return pd.DataFrame(rows)
+
+
+TABLES = {"points.csv": points}
+
+
+def write_tables(out):
+    """Every table, figure and the summary from out/runs.csv."""
+    out = Path(out)
+    runs = pd.read_csv(out / "runs.csv")
+    pts = points(runs)
+    tables = {"points.csv": pts, "predictions.csv": predictions(pts), "hysteresis.csv": hysteresis(pts),
+              "rolling.csv": rolling_effect(pts), "validation.csv": validation(pts), "checks.csv": checks(pts),
+              "engines.csv": engines(pts), "cost.csv": cost(runs)}
+    for name, t in tables.items():
+        t.to_csv(out / name, index=False)
+    from . import granular3d_figures
+
+    figs = granular3d_figures.draw(out, tables)
+    (out / "summary.md").write_text(summary(tables, figs))
+    print(f"wrote {len(tables) + 1} tables, {len(figs)} figures and summary.md in {out}")
+    return tables
+
+
+def _md(df, cols, fmt=".2f"):
+    if df is None or not len(df):
+        return "(none measured yet)\n"
+    head = "| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n"
+    body = ""
+    for _, r in df.iterrows():
+        cells = []
+        for c in cols:
+            v = r[c]
+            cells.append(f"{v:{fmt}}" if isinstance(v, (float, np.floating)) and np.isfinite(v) else
+                         "—" if isinstance(v, (float, np.floating)) else str(v))
+        body += "| " + " | ".join(cells) + " |\n"
+    return head + body
+
+
+def summary(t, figs):
+    pts = t["points.csv"]
+    lines = ["# Granular scale in 3D: the study's tables", "",
+             "Written by `stickslip study-3d` (stickslip/studies/granular3d.py, granular3d_tables.py) from "
+             "[runs.csv](runs.csv); the findings: [../granular-3d.md](../granular-3d.md). Angles in degrees, "
+             "means over fills ± their standard error (std/√n); z = difference / combined standard error.", "",
+             "## Points", ""]
+    view = pts.copy()
+    for a in ANGLES:
+        view[a] = [f"{m:.2f} ± {e:.2f}" if np.isfinite(m) and np.isfinite(e) else (f"{m:.2f}" if np.isfinite(m) else "—")
+                   for m, e in zip(view[f"{a}_mean"], view[f"{a}_se"])]
+    lines.append(_md(view, ["kind", "engine", "group", "material", "nu_s", "timing", "rolling", "layers",
+                            "rate_factor", "silbert", "fills", "theta_start", "theta_stop", "theta_heap"]))
+    lines += ["## Validation (stock history, μ = 0.5, no rolling resistance) against Weinhart et al. 2012", "",
+              _md(t["validation.csv"], ["engine", "layers", "depth_d", "theta_stop", "std", "fills",
+                                        "weinhart_at_depth", "difference", "within_0.7"]),
+              "## Checks of the set-up", "",
+              _md(t["checks.csv"], ["check", "angle", "reference", "checked", "difference", "z"]),
+              "## Predictions", "",
+              _md(t["predictions.csv"], ["angle", "material", "nu_s", "timing", "rolling", "measured", "se",
+                                         "predicted_at", "mu_predicted", "stock_at_predicted", "z_predicted",
+                                         "stock_at_mu_k", "z_mu_k"]),
+              "## Hysteresis θ_start − θ_stop against μs − μk", "",
+              _md(t["hysteresis.csv"], ["rolling", "nu_s", "timing", "points", "slope_deg_per_unit_mu", "slope_se", "z"]),
+              "## Rolling resistance and the law's effect (d = angle − stock at μs)", "",
+              _md(t["rolling.csv"], list(t["rolling.csv"].columns) if len(t["rolling.csv"]) else ["angle"]),
+              "## LAMMPS against LIGGGHTS", "",
+              _md(t["engines.csv"], ["material", "nu_s", "layers", "angle", "liggghts", "liggghts_std", "lammps",
+                                     "lammps_std", "difference", "z"]),
+              "## Cost", "",
+              _md(t["cost.csv"], ["engine", "kind", "runs", "wall_s_total", "seconds_per_grain_step",
+                                  "mean_simulated_time"], ".3g"),
+              ""] + [f"![{f}]({f})" for f in figs] + [""]
+    return "\n".join(lines)

@@ -1,0 +1,271 @@
+"""Issue 39, the granular scale in 3D: the scene format's 3D features (periodic boxes, a
+rough base, the gravity ramp, rolling resistance, the bulk columns) and their refusals,
+the LAMMPS-family script of the ramp, the case kinds incline3d and heap3d, the study's
+smoke run and `stickslip calibrate`. The study itself is opt-in (slow)."""
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from stickslip import columns, runner
+from stickslip import scene as scene_mod
+from stickslip.adapters import lammps_family
+from stickslip.adapters import ramp_script
+from stickslip.cli import main
+from stickslip.errors import SceneError
+from stickslip.kinds import heap3d, incline3d
+from stickslip.scene.grains import near_pairs_periodic
+from conftest import needs_engine
+
+needs_liggghts = needs_engine("liggghts")
+needs_lammps = needs_engine("lammps")
+
+SMALL = tomllib.loads(scene_mod.find("incline3d_small").read_text())
+
+
+def parse(change=None, drop=()):
+    """cases/incline3d_small.toml's data, changed: change(data) edits it in place."""
+    data = copy.deepcopy(SMALL)
+    for path in drop:
+        *head, last = path.split(".")
+        t = data
+        for h in head:
+            t = t[h]
+        del t[last]
+    if change:
+        change(data)
+    return scene_mod.parse(data)
+
+
+# ---------------------------------------------------------------- the scene format's checks
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: d.update(dimension=2, gravity=[0.0, -1.0]), "periodic: periodic boundaries are for 3D scenes"),
+    (lambda d: d["periodic"].update(x=[1.0, 0.5]), "periodic.x: expected [lo, hi] with lo < hi"),
+    (lambda d: d["periodic"].update(x=[0.0, 2.0]), "periodic.x = [0, 2]: must be longer than two largest diameters"),
+    (lambda d: d["periodic"].update(x=[0.0, 4.0]), "outside the periodic box periodic.x = [0, 4)"),
+    (lambda d: d["wall"].append({"name": "side", "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}),
+     "wall 'side': its normal has a part along the periodic axis x"),
+    (lambda d: d["gravity_ramp"].update(axis=[0.0, 0.0, 1.0]), "gravity_ramp.axis = [0.0, 0.0, 1.0]: must be a "
+                                                               "non-zero vector perpendicular to gravity"),
+    (lambda d: d["gravity_ramp"]["phase"][1].update(duration=2.0), "gravity_ramp.phase[1]: give exactly one of"),
+    (lambda d: d["gravity_ramp"]["phase"][0].pop("duration"), "gravity_ramp.phase[0]: give exactly one of"),
+    (lambda d: d["gravity_ramp"].update(phase=[]), "gravity_ramp.phase: at least one"),
+    (lambda d: d.update(gravity_rate=0.1), "gravity_rate = 0.1: gravity turns about z, in 2D scenes only"),
+    (lambda d: d["analysis"].update(stop_phase=6), "analysis.stop_phase = 6: must be the index of a "
+                                                    "gravity_ramp.phase (0 to 5)"),
+    (lambda d: d["base"][0].update(number_density=5.0), "base[0].number_density = 5: at most"),
+    (lambda d: d["contact"].update(rolling_mu=0.1), "contact.rolling_mu = 0.1: needs a rolling model"),
+    (lambda d: d["contact"].update(rolling="epsd2"), "contact.rolling_mu = 0: must be > 0"),
+    (lambda d: d["contact"].update(rolling="cdt", rolling_mu=0.1), "contact.rolling = 'cdt': must be one of"),
+    (lambda d: (d["contact"].update(rolling="epsd2", rolling_mu=0.1), d["effects"].update(rotation=False)),
+     "contact.rolling = 'epsd2': rolling resistance acts on spins"),
+])
+def test_3d_scene_errors_are_one_line(change, message):
+    with pytest.raises(SceneError) as e:
+        parse(change)
+    assert message in str(e.value) and "\n" not in str(e.value)
+
+
+def test_a_grain_overlapping_its_neighbour_across_the_periodic_boundary_is_refused():
+    def two(d):
+        d["lattice"] = []
+        d["grain"] = [{"name": "a", "radius": 0.5, "density": 1.9, "position": [0.2, 2.0, 3.0]},
+                      {"name": "b", "radius": 0.5, "density": 1.9, "position": [4.85, 2.0, 3.0]}]
+    with pytest.raises(SceneError, match="grains 'a' and 'b' start overlapping by 0.65 m"):
+        parse(two)
+    # the same pair without the periodic box is far apart
+    x = np.array([[0.2, 2.0, 3.0], [4.85, 2.0, 3.0]])
+    a, b, dist = near_pairs_periodic(x, np.array([0.5, 0.5]), {"x": (0.0, 5.0)})
+    assert list(zip(a, b)) == [(0, 1)] and dist[0] == pytest.approx(0.35)
+
+
+def test_the_base_is_a_slab_of_spheres_that_do_not_overlap_even_across_the_box():
+    sc = parse()
+    base = [g for g in sc.grains if g.fixed]
+    assert len(base) == round(1.14 * 25)  # number_density x the periodic box's area
+    x = np.array([g.position for g in base])
+    assert x[:, 2].min() >= 0 and x[:, 2].max() <= 1.18 and x[:, :2].min() >= 0 and x[:, :2].max() < 5.0
+    _, _, dist = near_pairs_periodic(x, np.full(len(x), 0.5), sc.periodic)
+    assert dist.min() >= 1.0 - 1e-5  # relaxed until no overlap beyond BASE_OVERLAP of a diameter
+    again = [g.position for g in parse().grains if g.fixed]
+    assert np.array_equal(x, again)  # the seed makes the same base
+
+
+def test_the_ramp_turns_gravity_towards_the_downhill_direction():
+    sc = parse()
+    assert np.allclose(sc.downhill(), [1.0, 0.0, 0.0])  # axis -y turns gravity (0, 0, -1) towards +x
+    a = math.radians(30)
+    assert np.allclose(sc.gravity_tilted(a), [math.sin(a), 0.0, -math.cos(a)])
+    assert [p.until for p in sc.gravity_ramp.phases] == ["duration", "speed_above", "duration", "speed_below",
+                                                         "speed_below", "speed_above"]
+    assert columns.names(sc)[-8:] == ["com_x", "com_y", "com_z", "vcm_x", "vcm_y", "vcm_z", "tilt", "phase"]
+
+
+@pytest.mark.parametrize("engine", ["pyref", "yade", "deme"])
+def test_engines_without_the_3d_features_refuse_the_scene_in_one_line(engine, tmp_path):
+    from stickslip import adapters
+
+    sc = parse(lambda d: d["contact"].update(rolling="epsd2", rolling_mu=0.1))
+    with pytest.raises(ValueError) as e:
+        adapters.get(engine).run(sc, tmp_path)
+    text = str(e.value)
+    assert text.endswith("it does not support periodic boundaries (periodic), gravity ramps (gravity_ramp), "
+                         "rolling resistance (contact.rolling), the bulk columns (output.bulk)") and "\n" not in text
+
+
+def test_lammps_refuses_rolling_resistance_only(tmp_path):
+    from stickslip.adapters import lammps
+
+    with pytest.raises(ValueError, match=r"LAMMPS cannot run scene incline3d_small: it does not support rolling "
+                                         r"resistance \(contact.rolling\)$"):
+        lammps.run(parse(lambda d: d["contact"].update(rolling="epsd2", rolling_mu=0.1)), tmp_path)
+
+
+# ---------------------------------------------------------------- the script both engines run
+
+def test_the_loop_redefines_only_variables_defined_after_every_other():
+    """LIGGGHTS moves a redefined variable to the end of its list (ramp_script.py): every
+    variable the loop redefines must come after every variable a fix, compute or dump holds."""
+    sc = parse()
+    lines = lammps_family.gravity(sc) + ramp_script.bulk_dump(sc, "moving", lambda d, n: "") + ramp_script.run(
+        sc, lambda steps: ["thermo 1", f"run {steps}"])
+    defined = [ln.split()[1] for ln in lines if ln.startswith("variable ")]
+    first_loop = lines.index("run 0")
+    redefined = {ln.split()[1] for ln in lines[first_loop:] if ln.startswith("variable ")}
+    order = list(dict.fromkeys(defined))
+    assert redefined and all(order.index(v) > order.index(w) for v in redefined for w in order if w not in redefined)
+    assert "fix gravity all gravity 1.0 vector v_rp_gx v_rp_gy v_rp_gz" in lines
+    assert f"run {sc.output.every} pre no post no" in lines
+    assert 'if "${bk_down} < 0.001" then "jump SELF rp_phase5"' in lines
+    assert 'if "${rp_n} >= 30" then "jump SELF rp_phase1"' in lines  # 3 s in intervals of 0.1 s
+
+
+@pytest.mark.parametrize("engine", [pytest.param("liggghts", marks=needs_liggghts),
+                                    pytest.param("lammps", marks=needs_lammps)])
+def test_the_ramp_turns_by_its_rates_phase_by_phase_on_the_engines(engine, tmp_path):
+    """The first 4 time units of the small incline: phase 0 holds the angle for its 3 s (30
+    intervals), phase 1 turns it by 5 deg/s, 0.5 deg a row; the bulk columns follow the bed."""
+    sc = scene_mod.load("incline3d_small", duration=4.0)
+    _, df = runner.run_scene(sc, engine, tmp_path, progress=False)
+    assert list(df.columns) == columns.names(sc) and len(df) == 41
+    assert (df["phase"].iloc[:31] == 0).all() and (df["tilt"].iloc[:31] == 0).all()
+    assert (df["phase"].iloc[31:] == 1).all()
+    assert np.allclose(np.degrees(df["tilt"].iloc[31:]), 0.5 * np.arange(1, 11), atol=1e-9)
+    assert df["com_z"].iloc[-1] < df["com_z"].iloc[0] - 0.5  # the lattice fell onto the base
+
+
+# ---------------------------------------------------------------- the kinds
+
+def _ramp_frame(speeds, phases, tilts):
+    n = len(speeds)
+    return pd.DataFrame({"t": np.arange(n) * 0.1, "com_x": 0.0, "com_y": 0.0, "com_z": 6.0, "vcm_x": speeds,
+                         "vcm_y": 0.0, "vcm_z": 0.0, "tilt": np.radians(tilts), "phase": phases})
+
+
+def test_incline_angles_are_read_where_their_phases_end():
+    sc = parse()
+    df = _ramp_frame([0, 0.5, 0.2, 0.0005, 0.004, 0.02], [0, 1, 4, 4, 5, 5], [0, 20, 21, 20.5, 21, 22])
+    s = incline3d.summarise(sc, df)
+    assert s["theta_stop_deg"] == pytest.approx(20.5) and s["theta_start_deg"] == pytest.approx(22)
+    z_base = np.mean([g.position[2] + g.radius for g in sc.grains if g.fixed])
+    assert s["depth_at_stop"] == pytest.approx(2 * (6.0 - z_base))
+    # the run ended before the last phase's condition held: no theta_start
+    s = incline3d.summarise(sc, df.iloc[:5])
+    assert s["theta_stop_deg"] == pytest.approx(20.5) and math.isnan(s["theta_start_deg"])
+
+
+def test_heap_flanks_of_a_known_slope():
+    """A heap of grains stacked under two flanks of slope 0.5 (26.57 deg) on the small
+    heap's plate: the fit reads that slope on both sides."""
+    sc = scene_mod.load("heap3d_small")
+    lo, hi, z0 = heap3d.plate(sc)
+    names = [g.name for g in sc.grains if not g.fixed]
+    row = {}
+    xs = np.linspace(lo + 0.3, hi - 0.3, len(names))
+    for n, x in zip(names, xs):
+        r = next(g.radius for g in sc.grains if g.name == n)
+        row.update({f"{n}_x": x, f"{n}_y": 1.0, f"{n}_z": z0 + 0.5 * (0.5 * (hi - lo) - abs(x - 0.5 * (lo + hi))) - r,
+                    **{f"{n}_v{a}": 0.0 for a in "xyz"}})
+    (left, right), height = heap3d.flanks(*heap3d.profile(sc, pd.Series(row)))
+    assert left == pytest.approx(0.5, abs=0.03) and right == pytest.approx(0.5, abs=0.03)
+
+
+# ---------------------------------------------------------------- the study and calibrate
+
+@needs_liggghts
+def test_study_smoke_states_its_cost_keeps_its_runs_and_resumes(tmp_path, capsys):
+    args = ["study-3d", "--smoke", "--runs", str(tmp_path / "runs"), "--out", str(tmp_path / "out"), "--quiet"]
+    assert main(args) == 0
+    err = capsys.readouterr().err
+    assert "stickslip study-3d: 3 runs, 0 already on disk" in err and "3 to run (2 at once), about" in err
+    runs = pd.read_csv(tmp_path / "out" / "runs.csv")
+    assert len(runs) == 3 and np.isfinite(runs.loc[runs.kind == "incline", "theta_stop"]).all()
+    assert np.isfinite(runs.loc[runs.kind == "heap", "theta_heap"]).all()
+    for name in ("points.csv", "predictions.csv", "summary.md", "granular3d_curves.png", "granular3d_map.png"):
+        assert (tmp_path / "out" / name).is_file()
+    assert main(args) == 0  # everything is on disk: nothing runs again
+    assert "to run" not in capsys.readouterr().err
+
+
+def _synthetic_map(tmp_path):
+    """A points.csv whose angles are linear in (mu_s, mu_k): theta_start = 20 + 20 mu_s,
+    theta_stop = 15 + 20 (2 mu_k - mu_s), theta_heap = 18 + 16 (2 mu_k - mu_s), se 0.3."""
+    rows = []
+    pairs = [(m, m) for m in (0.2, 0.35, 0.5, 0.8)] + [(0.8, 0.5), (0.8, 0.65), (0.5, 0.35), (0.5, 0.425)]
+    for ms, mk in pairs:
+        for kind in ("incline", "heap"):
+            f = 2 * mk - ms
+            rows.append({"kind": kind, "engine": "liggghts", "group": "sweep", "mu_s": ms, "mu_k": mk,
+                         "nu_s": "0" if ms == mk else "paper", "timing": "step", "rolling": 0.0,
+                         "theta_start_mean": 20 + 20 * ms if kind == "incline" else np.nan, "theta_start_se": 0.3,
+                         "theta_stop_mean": 15 + 20 * f if kind == "incline" else np.nan, "theta_stop_se": 0.3,
+                         "theta_heap_mean": 18 + 16 * f if kind == "heap" else np.nan, "theta_heap_se": 0.3})
+    path = tmp_path / "points.csv"
+    pd.DataFrame(rows).to_csv(path, index=False)
+    return path
+
+
+def test_calibrate_inverts_the_map(tmp_path, capsys):
+    path = _synthetic_map(tmp_path)
+    # mu_s = 0.7, mu_k = 0.5: theta_start 34, theta_stop 21, theta_heap 22.8
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--map", str(path)]) == 0
+    out = capsys.readouterr().out
+    ms = float(out.split("mu_s = ")[1].split()[0])
+    mk = float(out.split("mu_k = ")[1].split()[0])
+    assert ms == pytest.approx(0.7, abs=0.005) and mk == pytest.approx(0.5, abs=0.005)
+    # one standard error of an angle (0.3 deg) moves mu_s by 0.3/20 = 0.015: the range says so
+    lo, hi = (float(v) for v in out.split("mu_s = ")[1].split("error: ")[1].split(")")[0].split(" to "))
+    assert 0.01 < hi - ms < 0.03 and 0.01 < ms - lo < 0.03
+    assert main(["calibrate", "--theta-stop", "21", "--theta-heap", "22.8", "--map", str(path)]) == 0
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--theta-start", "34"], "give at least two of --theta-start, --theta-stop, --theta-heap"),
+    (["--theta-start", "45", "--theta-stop", "21"], "--theta-start 45: outside the measured map, which reaches "
+                                                    "theta_start from 24.0 to 36.0 deg"),
+    (["--theta-start", "25", "--theta-stop", "30"], "no (mu_s, mu_k) of the map gives these together"),
+    (["--theta-start", "34", "--theta-stop", "21", "--rolling", "0.3"], "--rolling 0.3: the map was measured at "
+                                                                        "rolling resistance 0 only"),
+    (["--theta-start", "95", "--theta-stop", "21"], "must be an angle in degrees, in (0, 90)"),
+])
+def test_calibrate_refuses_in_one_line_with_status_2(tmp_path, capsys, argv, message):
+    path = _synthetic_map(tmp_path)
+    with pytest.raises(SystemExit) if "95" in argv else _nothing():
+        code = main(["calibrate", *argv, "--map", str(path)])
+        assert code == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+
+
+class _nothing:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
