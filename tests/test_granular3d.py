@@ -269,3 +269,72 @@ class _nothing:
 
     def __exit__(self, *exc):
         return False
+
+
+def _rolling_sphere(mu_r):
+    """A sphere (d = 1, m = 1) rolling along +x on a floor at 1 d/time unit (spin matched:
+    no sliding), g = 1, the study's contact, for 2 time units."""
+    data = {"name": "rolling", "dimension": 3, "gravity": [0.0, 0.0, -1.0],
+            "effects": {"gravity": True, "rotation": True, "normal_damping": True},
+            "contact": {"law": "stick_slip", "kn": 2e4, "nu_n": 7.906, "ks": 5714.285714285714, "mu_s": 0.5,
+                        "mu_k": 0.5, **({"rolling": "epsd2", "rolling_mu": mu_r} if mu_r else {})},
+            "time": {"dt": 5e-4, "duration": 2.0}, "output": {"every": 400, "grains": ["ball"]},
+            "grain": [{"name": "ball", "radius": 0.5, "density": 1.909859317102744, "position": [0.0, 0.0, 0.49995],
+                       "velocity": [1.0, 0.0, 0.0], "angular_velocity": [0.0, 2.0, 0.0]}],
+            "wall": [{"name": "floor", "point": [0.0, 0.0, 0.0], "normal": [0.0, 0.0, 1.0]}]}
+    return scene_mod.parse(data)
+
+
+@needs_liggghts
+def test_rolling_resistance_epsd2_with_stick_slip_on_liggghts(tmp_path):
+    """epsd2's torque, capped at mu_r R Fn, slows a rolling sphere (no sliding) by
+    a = mu_r g R r / (I + m r^2) = mu_r g / 1.4 (R = r on a wall): 0.1 * 2 / 1.4 = 0.143 over
+    2 time units (the spring of epsd2 reaches its cap within a few steps); without it the
+    sphere keeps its speed. The stick_slip combination with rolling_friction epsd2 is
+    registered for the pair style and the walls (liggghts_plugin/register_combinations.cpp:
+    every combination the library has with history); the incline's grains use it on pairs."""
+    from stickslip.adapters import liggghts
+
+    _, free = runner.run_scene(_rolling_sphere(0.0), "liggghts", tmp_path / "free", progress=False)
+    _, slowed = runner.run_scene(_rolling_sphere(0.1), "liggghts", tmp_path / "epsd2", progress=False)
+    assert free["ball_vx"].iloc[-1] == pytest.approx(1.0, abs=2e-3)
+    assert 1.0 - slowed["ball_vx"].iloc[-1] == pytest.approx(0.1 * 2.0 / 1.4, rel=0.05)
+    sc = scene_mod.load("incline3d_small", duration=1.0, rolling="epsd2", rolling_mu=0.1)
+    runner.run_scene(sc, "liggghts", tmp_path / "incline", progress=False)
+    text = (tmp_path / "incline" / "liggghts" / "in.scene").read_text()
+    assert "pair_style gran model hooke/stiffness tangential stick_slip rolling_friction epsd2" in text
+    assert "coefficientRollingFriction peratomtypepair 1 0.1" in text and liggghts.LAUNCHER.is_file()
+
+
+DOCS = scene_mod.CASES_DIR.parent / "docs" / "granular-3d"
+
+
+@pytest.mark.skipif(not (DOCS / "runs.csv").is_file(), reason="the study's results are not committed")
+def test_the_committed_figures_and_tables_come_from_the_committed_runs(tmp_path):
+    """`stickslip study-3d --from-csv` redraws docs/granular-3d from its runs.csv alone, and
+    the tables it writes are the committed ones."""
+    import shutil
+
+    shutil.copy(DOCS / "runs.csv", tmp_path / "runs.csv")
+    assert main(["study-3d", "--from-csv", "--out", str(tmp_path)]) == 0
+    for name in ("points.csv", "predictions.csv", "validation.csv", "engines.csv", "hysteresis.csv"):
+        got, committed = pd.read_csv(tmp_path / name), pd.read_csv(DOCS / name)
+        pd.testing.assert_frame_equal(got, committed, check_exact=False, rtol=1e-9)
+    for png in DOCS.glob("*.png"):
+        assert (tmp_path / png.name).is_file()
+
+
+@pytest.mark.slow
+@needs_liggghts
+def test_weinhart_h_stop_at_10_d_on_liggghts(tmp_path):
+    """The validation of issue 39 from scratch (about 15 CPU minutes): stock history mu = 0.5
+    without rolling resistance, 3 fills of the 10 d bed; theta_stop within 0.7 deg of
+    Weinhart et al.'s fit at the measured depth."""
+    from stickslip.studies import granular3d, granular3d_tables
+
+    jobs = [j for j in granular3d.matrix(checks=False, engines=("liggghts",))
+            if j.kind == "incline" and j.material == "history_0.50" and j.rolling == 0]
+    t = granular3d.run_study(tmp_path / "out", tmp_path / "runs", jobs=jobs, progress=False)
+    v = t["validation.csv"]
+    assert len(v) == 1 and v["fills"].iloc[0] == 3 and bool(v["within_0.7"].iloc[0])
+    assert granular3d_tables.weinhart_theta_stop(10.0) == pytest.approx(21.98, abs=0.01)

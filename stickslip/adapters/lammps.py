@@ -248,4 +248,5 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     cmd = [str(launcher or LAUNCHER), "-in", "in.scene", "-log", "log.lammps", "-echo", "none", "-nocite"]
     loop_time = run_script("LAMMPS", cmd, work, scene.steps, progress, np_ranks, env={"OMP_NUM_THREADS": "1"})
     df = _timeseries(script, work)
-    return RunResult(df, int(round(df["t"].iloc[-1] / scene.dt)), loop_time, notes=script.notes)  # a ramp may end it early
+    steps = int(round(df["t"].iloc[-1] / scene.dt))  # a gravity ramp may end the run early
+    return RunResult(df, steps, loop_time, notes=script.notes)

@@ -81,7 +81,8 @@ def summarise(scene, df):
 
 
 def errors(scene, summary, df, ref_summary, ref_df):
-    return {"theta_heap": abs(summary["theta_heap_deg"] - ref_summary["theta_heap_deg"]) / ref_summary["theta_heap_deg"]}
+    ref = ref_summary["theta_heap_deg"]
+    return {"theta_heap": abs(summary["theta_heap_deg"] - ref) / ref}
 
 
 def claims(scene):

@@ -418,13 +418,14 @@ def _gravity_ramp(top: Table, dim, effects, gravity, gravity_rate):
     axis = rt.vector("axis", 3, required=True)
     g = gravity / np.linalg.norm(gravity)
     if np.linalg.norm(axis) == 0 or abs(float(axis @ g)) > 1e-9 * np.linalg.norm(axis):
-        raise SceneError(f"gravity_ramp.axis = {shown([float(a) for a in axis])}: must be a non-zero vector perpendicular to "
-                         "gravity (gravity turns about it)")
+        raise SceneError(f"gravity_ramp.axis = {shown([float(a) for a in axis])}: must be a non-zero vector "
+                         "perpendicular to gravity (gravity turns about it)")
     max_angle = rt.number("max_angle", 90.0, lo=0, lo_open=True, hi=180.0)
     phases = []
     for i, ph in enumerate(rt.array("phase")):
         pt = Table(ph, f"gravity_ramp.phase[{i}]")
-        rate = pt.number("rate", required=True, lo=-MAX_GRAVITY_RATE * 180 / math.pi, hi=MAX_GRAVITY_RATE * 180 / math.pi)
+        most = math.degrees(MAX_GRAVITY_RATE)
+        rate = pt.number("rate", required=True, lo=-most, hi=most)
         given = [c for c in RAMP_CONDITIONS if c in pt.data]
         if len(given) != 1:
             raise SceneError(f"gravity_ramp.phase[{i}]: give exactly one of {', '.join(RAMP_CONDITIONS)} (how the "

@@ -140,8 +140,17 @@ def scene_data(job, base):
     for block in data.get("base", []) + data.get("lattice", []):
         block["seed"] = job.fill
     if job.layers:
+        # a deeper bed: its flow's speed (Bagnold, ~h^1.5 at a given h/h_stop) and the time it
+        # takes to reach it grow with depth, so the ramp's rates scale as (h/h0)^-1.5 (measured:
+        # at the 10 d bed's rates a 20 d bed lagged its steady speed by ~3x and stopped 2 deg
+        # low) and the speed that ends the fast descent as (h/h0)^0.5 (Froude scaling)
+        ratio = job.layers / base["lattice"][0]["counts"][2]
         data["lattice"][0]["counts"][2] = job.layers
-        data["time"]["duration"] *= job.layers / base["lattice"][0]["counts"][2]
+        for ph in data["gravity_ramp"]["phase"]:
+            ph["rate"] *= ratio ** -1.5
+            if "speed_below" in ph and ph["speed_below"] > 0.1:
+                ph["speed_below"] *= ratio ** 0.5
+        data["time"]["duration"] *= ratio ** 2.5
     if job.rate_factor != 1.0:
         for ph in data["gravity_ramp"]["phase"]:
             ph["rate"] *= job.rate_factor
@@ -168,8 +177,7 @@ def plan(jobs, out_runs, scenes=None):
 def estimate(job, sc):
     """CPU seconds a run takes (SECONDS_PER_GRAIN_STEP, INCLINE_TIME), only to say beforehand."""
     if job.kind == "incline":
-        layers = job.layers or 18
-        sim = INCLINE_TIME * (layers / 18) ** 0.5 / job.rate_factor
+        sim = INCLINE_TIME * ((job.layers or 18) / 18) ** 1.5 / job.rate_factor
     else:
         sim = sc.duration
     return SECONDS_PER_GRAIN_STEP[job.engine] * len(sc.grains) * sim / sc.dt

@@ -192,7 +192,8 @@ def checks(pts):
     if not len(ref):
         return pd.DataFrame(rows)
     ref = ref.iloc[0]
-    for what, sel in (("rates halved", inc.rate_factor == 0.5), ("Silbert's kn = 2e5, dt = 1e-4", inc.silbert.astype(bool))):
+    for what, sel in (("rates halved", inc.rate_factor == 0.5),
+                      ("Silbert's kn = 2e5, dt = 1e-4", inc.silbert.astype(bool))):
         for _, p in inc[sel].iterrows():
             for a in ("theta_stop", "theta_start"):
                 rows.append({"check": what, "angle": a, "reference": ref[f"{a}_mean"], "reference_se": ref[f"{a}_se"],
@@ -209,7 +210,8 @@ def engines(pts):
     lig = pts[pts.engine == "liggghts"]
     for _, p in lam.iterrows():
         q = lig[(lig.kind == p.kind) & (lig.material == p.material) & (lig.nu_s == p.nu_s) & (lig.timing == p.timing)
-                & (lig["rolling"] == p["rolling"]) & (lig.layers == p.layers) & (lig.rate_factor == 1) & (~lig.silbert.astype(bool))]
+                & (lig["rolling"] == p["rolling"]) & (lig.layers == p.layers) & (lig.rate_factor == 1)
+                & (~lig.silbert.astype(bool))]
         if not len(q):
             continue
         q = q.iloc[0]
@@ -278,8 +280,8 @@ def summary(t, figs):
              "## Points", ""]
     view = pts.copy()
     for a in ANGLES:
-        view[a] = [f"{m:.2f} ± {e:.2f}" if np.isfinite(m) and np.isfinite(e) else (f"{m:.2f}" if np.isfinite(m) else "—")
-                   for m, e in zip(view[f"{a}_mean"], view[f"{a}_se"])]
+        view[a] = [f"{m:.2f} ± {e:.2f}" if np.isfinite(m) and np.isfinite(e)
+                   else (f"{m:.2f}" if np.isfinite(m) else "—") for m, e in zip(view[f"{a}_mean"], view[f"{a}_se"])]
     lines.append(_md(view, ["kind", "engine", "group", "material", "nu_s", "timing", "rolling", "layers",
                             "rate_factor", "silbert", "fills", "theta_start", "theta_stop", "theta_heap"]))
     lines += ["## Validation (stock history, μ = 0.5, no rolling resistance) against Weinhart et al. 2012", "",
@@ -292,7 +294,8 @@ def summary(t, figs):
                                          "predicted_at", "mu_predicted", "stock_at_predicted", "z_predicted",
                                          "stock_at_mu_k", "z_mu_k"]),
               "## Hysteresis θ_start − θ_stop against μs − μk", "",
-              _md(t["hysteresis.csv"], ["rolling", "nu_s", "timing", "points", "slope_deg_per_unit_mu", "slope_se", "z"]),
+              _md(t["hysteresis.csv"], ["rolling", "nu_s", "timing", "points", "slope_deg_per_unit_mu", "slope_se",
+                                        "z"]),
               "## Rolling resistance and the law's effect (d = angle − stock at μs)", "",
               _md(t["rolling.csv"], list(t["rolling.csv"].columns) if len(t["rolling.csv"]) else ["angle"]),
               "## LAMMPS against LIGGGHTS", "",
