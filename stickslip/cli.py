@@ -292,12 +292,12 @@ def cmd_drum_engines(args):
 
 
 def cmd_study_3d(args):
-    from .studies import granular3d, granular3d_tables
+    from .studies import granular3d
 
     if args.from_csv:
         if not (args.out / "runs.csv").is_file():
             raise SceneError(f"--from-csv: {args.out / 'runs.csv'} not found (run the study first)")
-        granular3d_tables.write_tables(args.out)
+        granular3d.write_results(args.out)
         return 0
     smoke = {"jobs": granular3d.smoke_jobs(), "scenes": granular3d.SMOKE_SCENES} if args.smoke else {}
     granular3d.run_study(args.out, args.runs, fills=tuple(range(1, args.fills + 1)), checks=not args.no_checks,

@@ -121,7 +121,7 @@ class _Script:
         for k, w in enumerate(sc.walls):
             self._wall(k, w, args, keywords)
         if eff["gravity"]:
-            self.add(*gravity(sc))
+            self.add(*(ramp_script.ramp_setup(sc) if sc.gravity_ramp is not None else gravity(sc)))
         # rotation off: integrate translation only, spins stay zero
         moving, lines = integrated(sc, self.ids)
         self.moving = moving

@@ -60,10 +60,8 @@ def gravity(scene):
     gn = float(np.linalg.norm(g))
     if gn == 0:
         return []
-    if scene.gravity_ramp is not None:  # turned in steps by the run's control loop (ramp_script.py)
-        from .ramp_script import ramp_setup  # (ramp_script takes fmt from here)
-
-        return ramp_setup(scene)
+    if scene.gravity_ramp is not None:  # turned in steps by the run's control loop
+        raise ValueError("a gravity ramp's gravity is ramp_script.ramp_setup's")
     u = g / gn
     if not scene.gravity_rate:
         return [f"fix gravity all gravity {gn!r} vector {vec(u)}"]

@@ -155,7 +155,7 @@ class _Script:
             else:
                 self.add(f"fix move{k} all move/mesh mesh mesh{k} linear {_vec(w.velocity)}")
         if eff["gravity"]:
-            self.add(*gravity(sc))
+            self.add(*(ramp_script.ramp_setup(sc) if sc.gravity_ramp is not None else gravity(sc)))
         # rotation off: integrate translation only, spins stay zero (nothing paid for them)
         moving, lines = integrated(sc, self.ids)
         self.moving = moving

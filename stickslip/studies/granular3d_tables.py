@@ -1,7 +1,7 @@
-"""The tables, tests of the predictions, figures and summary of `stickslip study-3d`
+"""The tables, tests of the predictions and summary of `stickslip study-3d`
 (docs/granular-3d.md), all from runs.csv: `write_runs` makes runs.csv from the finished
-runs, `write_tables` everything else from runs.csv alone, so that the committed CSVs
-redraw every figure (`stickslip study-3d --from-csv`).
+runs, `write_tables` the other tables from runs.csv alone, so that the committed CSVs
+redraw every table and figure (`stickslip study-3d --from-csv`; granular3d_figures.py).
 
 Means are over fills, with their spread: std (ddof 1) and standard error std/sqrt(n).
 A prediction "X falls on the stock curve at mu" is tested by z = (X - curve(mu)) /
@@ -17,8 +17,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-
-from . import granular3d as g3
 
 ANGLES = ("theta_start", "theta_stop", "theta_heap")
 # Weinhart et al. (2012, Granular Matter 14, 531), their fit of h_stop for a base of fixed
@@ -40,6 +38,7 @@ def write_runs(finished, out):
     rows = []
     for job, sc, _, folder in finished:
         s = json.loads((folder / "summary.json").read_text())
+        area = math.prod(hi - lo for lo, hi in sc.periodic.values()) if job.kind == "incline" else math.nan
         rows.append({"label": job.label, "kind": job.kind, "engine": job.engine, "group": job.group,
                      "material": job.material, "mu_s": job.mu_s, "mu_k": job.mu_k, "nu_s": job.nu_s,
                      "timing": job.timing, "rolling": job.rolling, "layers": job.layers or 0,
@@ -47,12 +46,14 @@ def write_runs(finished, out):
                      "grains": len(sc.grains), "dt": sc.dt, "steps": s["steps"], "wall_time_s": s["wall_time_s"],
                      "theta_start": s.get("theta_start_deg", math.nan), "theta_stop": s.get("theta_stop_deg", math.nan),
                      "theta_heap": s.get("theta_heap_deg", math.nan), "depth_at_stop": s.get("depth_at_stop", math.nan),
+                     # Silbert et al.'s measure of a bed's depth: flowing grains per d^2 of the base
+                     "grains_per_area": len(sc.moving_grains()) / area,
                      "heap_flank_half_difference": s.get("flank_half_difference_deg", math.nan),
                      "heap_ekin_per_grain_mgd": s.get("heap_ekin_per_grain_mgd", math.nan)})
     out.mkdir(parents=True, exist_ok=True)
     runs = pd.DataFrame(rows)
     runs.to_csv(out / "runs.csv", index=False)
-    return write_tables(out)
+    return runs
 
 
 def points(runs):
@@ -63,7 +64,7 @@ def points(runs):
     rows = []
     for key, grp in runs.groupby(KEYS, sort=False, dropna=False):
         row = dict(zip(KEYS, key))
-        for a in ANGLES + ("depth_at_stop",):
+        for a in ANGLES + ("depth_at_stop", "grains_per_area"):
             v = grp[a].to_numpy(float)
             v = v[np.isfinite(v)]
             row[f"{a}_mean"] = float(v.mean()) if len(v) else math.nan
@@ -176,10 +177,15 @@ def validation(pts):
             (pts.rate_factor == 1) & (~pts.silbert.astype(bool)) & pts.group.isin(["sweep", "validation"])]
     for _, p in h.iterrows():
         w = weinhart_theta_stop(p.depth_at_stop_mean)
+        wn = weinhart_theta_stop(p.grains_per_area_mean)
         rows.append({"engine": p.engine, "layers": int(p.layers) or 18, "depth_d": p.depth_at_stop_mean,
                      "theta_stop": p.theta_stop_mean, "std": p.theta_stop_std, "se": p.theta_stop_se,
                      "fills": p.fills, "weinhart_at_depth": w, "difference": p.theta_stop_mean - w,
-                     "within_0.7": abs(p.theta_stop_mean - w) <= VALIDATION_TOLERANCE})
+                     "z": _z(p.theta_stop_mean, p.theta_stop_se, w, 0.0),
+                     "within_0.7": abs(p.theta_stop_mean - w) <= VALIDATION_TOLERANCE,
+                     "grains_per_area": p.grains_per_area_mean, "weinhart_at_grains_per_area": wn,
+                     "difference_grains_per_area": p.theta_stop_mean - wn,
+                     "within_0.7_grains_per_area": abs(p.theta_stop_mean - wn) <= VALIDATION_TOLERANCE})
     return pd.DataFrame(rows)
 
 
@@ -239,7 +245,7 @@ TABLES = {"points.csv": points}
 
 
 def write_tables(out):
-    """Every table, figure and the summary from out/runs.csv."""
+    """Every table from out/runs.csv: {file name: DataFrame}, written beside it."""
     out = Path(out)
     runs = pd.read_csv(out / "runs.csv")
     pts = points(runs)
@@ -248,11 +254,6 @@ def write_tables(out):
               "engines.csv": engines(pts), "cost.csv": cost(runs)}
     for name, t in tables.items():
         t.to_csv(out / name, index=False)
-    from . import granular3d_figures
-
-    figs = granular3d_figures.draw(out, tables)
-    (out / "summary.md").write_text(summary(tables, figs))
-    print(f"wrote {len(tables) + 1} tables, {len(figs)} figures and summary.md in {out}")
     return tables
 
 
@@ -286,7 +287,8 @@ def summary(t, figs):
                             "rate_factor", "silbert", "fills", "theta_start", "theta_stop", "theta_heap"]))
     lines += ["## Validation (stock history, μ = 0.5, no rolling resistance) against Weinhart et al. 2012", "",
               _md(t["validation.csv"], ["engine", "layers", "depth_d", "theta_stop", "std", "fills",
-                                        "weinhart_at_depth", "difference", "within_0.7"]),
+                                        "weinhart_at_depth", "difference", "z", "within_0.7", "grains_per_area",
+                                        "weinhart_at_grains_per_area", "difference_grains_per_area"]),
               "## Checks of the set-up", "",
               _md(t["checks.csv"], ["check", "angle", "reference", "checked", "difference", "z"]),
               "## Predictions", "",
