@@ -132,7 +132,7 @@ def hysteresis(pts):
             y = (sel.theta_start_mean - sel.theta_stop_mean).to_numpy(float)
             e = np.hypot(sel.theta_start_se, sel.theta_stop_se).to_numpy(float)
             ok = np.isfinite(y) & np.isfinite(e) & (e > 0)
-            if ok.sum() < 3:
+            if ok.sum() < 3 or len(np.unique(x[ok])) < 2:  # a slope needs two values of mu_s - mu_k
                 continue
             w = 1 / e[ok] ** 2
             a = np.column_stack([np.ones(ok.sum()), x[ok]])
