@@ -14,7 +14,6 @@ import pytest
 
 from stickslip import columns, runner
 from stickslip import scene as scene_mod
-from stickslip.adapters import lammps_family
 from stickslip.adapters import ramp_script
 from stickslip.cli import main
 from stickslip.errors import SceneError
@@ -133,7 +132,7 @@ def test_the_loop_redefines_only_variables_defined_after_every_other():
     """LIGGGHTS moves a redefined variable to the end of its list (ramp_script.py): every
     variable the loop redefines must come after every variable a fix, compute or dump holds."""
     sc = parse()
-    lines = lammps_family.gravity(sc) + ramp_script.bulk_dump(sc, "moving", lambda d, n: "") + ramp_script.run(
+    lines = ramp_script.ramp_setup(sc) + ramp_script.bulk_dump(sc, "moving", lambda d, n: "") + ramp_script.run(
         sc, lambda steps: ["thermo 1", f"run {steps}"])
     defined = [ln.split()[1] for ln in lines if ln.startswith("variable ")]
     first_loop = lines.index("run 0")
