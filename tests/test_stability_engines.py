@@ -174,7 +174,7 @@ def test_sustained_slide_yade(tmp_path):
     sustained_slide("yade", tmp_path)  # ~4 min
 
 
-# ~15 s on LIGGGHTS, ~12 min on YADE (40 000 steps through the Python law)
+# ~15 s on LIGGGHTS; on YADE ~25 min at dt 5e-6 s (80 000 steps through the Python law), half the steps now
 @pytest.mark.parametrize("engine", [pytest.param("liggghts"), pytest.param("yade", marks=pytest.mark.slow)])
 def test_large_pour_settles(engine, tmp_path):
     """test_packing's 3000-disk pour (rotation, damping, gravity on) on an engine: every
