@@ -133,7 +133,7 @@ def run_pyref(sc, energy=False):
     return columns.frame(sc, sim.run()), sim
 
 
-SHARED = None  # the session's folder of shared pyref runs (set by shared_runs_folder)
+SHARED = None  # the session's folder of shared runs (set by shared_runs_folder)
 _loaded = {}   # this process's copies of them
 
 
@@ -146,27 +146,33 @@ def shared_runs_folder(tmp_path_factory):
     base = tmp_path_factory.getbasetemp()
     if os.environ.get("PYTEST_XDIST_WORKER"):
         base = base.parent
-    SHARED = base / "shared-pyref-runs"
+    SHARED = base / "shared-runs"
     SHARED.mkdir(exist_ok=True)
 
 
-def paper_case(name, **overrides):
-    """pyref's run of a case (a name and scene.load's overrides: duration, law, slip_timing,
-    ...), made once per test session and shared by every test that reads it, in every
-    xdist worker: the first to ask runs it while holding a file lock, the others wait for
-    it and read its time series. Returns (scene, time series). Runs are told apart by the
-    scene's data with the overrides written in (scene.identity): a value the file already
-    has is spelt by leaving the override out, as every caller does."""
-    sc = scene_mod.load(name, **overrides)
-    key = hashlib.sha256(scene_mod.identity(name, **overrides).encode()).hexdigest()[:24]
+def shared_result(name, identity, make):
+    """make()'s value, made once per test session and shared by every test that asks for the
+    same `identity` (a text that says everything the value depends on), in every xdist
+    worker: the first to ask makes it while holding a file lock, the others wait for it and
+    read it back (pickled). `name` only names the files."""
+    key = hashlib.sha256(identity.encode()).hexdigest()[:24]
     if key not in _loaded:
         path = SHARED / f"{name}-{key}.pkl"
         with open(SHARED / f"{name}-{key}.lock", "w") as lock:
             fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file is closed
             if not path.exists():
-                df, _ = run_pyref(sc)
                 part = path.with_suffix(".part")
-                df.to_pickle(part)
+                pd.to_pickle(make(), part)
                 part.rename(path)
             _loaded[key] = pd.read_pickle(path)
-    return sc, _loaded[key]
+    return _loaded[key]
+
+
+def paper_case(name, **overrides):
+    """pyref's run of a case (a name and scene.load's overrides: duration, law, slip_timing,
+    ...), made once per test session and shared by every test that reads it (shared_result).
+    Returns (scene, time series). Runs are told apart by the scene's data with the overrides
+    written in (scene.identity): a value the file already has is spelt by leaving the
+    override out, as every caller does."""
+    sc = scene_mod.load(name, **overrides)
+    return sc, shared_result(name, scene_mod.identity(name, **overrides), lambda: run_pyref(sc)[0])

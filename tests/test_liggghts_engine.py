@@ -144,14 +144,9 @@ def test_poured_packing_statistics_match_pyref(tmp_path):
     can agree (the tolerances of the YADE version of this test, tests/test_yade_engine.py):
     both at rest (kinetic energy < 1 % of its peak), mean height within 2 %, number of
     contacts within 10 %."""
-    import tomllib
+    from test_packing import statistics_pour
 
-    from test_packing import POUR
-
-    text = POUR.format(nx=12, ny=10, duration=0.15, dt=5e-6, width=0.003 + 12 * 2 * 0.002 * 1.2 * 1.05 + 0.001)
-    sc = scene_mod.parse(tomllib.loads(text))
-    sc.output.grains = [g.name for g in sc.grains]
-    dp, _ = run_pyref(sc)
+    sc, dp = statistics_pour()  # the YADE test's pour: pyref runs it once for both
     dl = liggghts_adapter.run(sc, tmp_path).timeseries
     for df in (dp, dl):
         assert np.isfinite(df.to_numpy()).all()

@@ -10,7 +10,7 @@ from stickslip import analysis
 from stickslip import scene as scene_mod
 from stickslip.adapters import yade as yade_adapter
 import twin_bound
-from conftest import needs_engine, paper_case, run_pyref
+from conftest import needs_engine, paper_case
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "yade_law"))
@@ -136,17 +136,12 @@ def test_poured_packing_statistics_match_pyref(tmp_path):
     within 10 % (coordination of a 2D frictional pile varies by a few % between
     realisations). The pour runs 0.3 s: at 0.15 s the piles are still making contacts
     (final counts 143-199 over four seeds on one engine, measured, so the 10 % held only
-    by luck), at 0.3 s they have settled (198-211 on pyref and YADE for two seeds)."""
-    import tomllib
+    by luck), at 0.3 s they have settled (198-211 on pyref and YADE for two seeds at dt =
+    5e-6 s; at 1e-5 s, the pour's dt here, 199 on both: tests/test_packing.py
+    STATISTICS_POUR)."""
+    from test_packing import statistics_pour
 
-    from test_packing import POUR
-    from conftest import run_pyref
-
-    text = POUR.format(nx=12, ny=10, duration=0.3, dt=5e-6, width=0.003 + 12 * 2 * 0.002 * 1.2 * 1.05 + 0.001)
-    data = tomllib.loads(text)
-    sc = scene_mod.parse(data)
-    sc.output.grains = [g.name for g in sc.grains]
-    dp, _ = run_pyref(sc)
+    sc, dp = statistics_pour()
     dy = yade_adapter.run(sc, tmp_path).timeseries
     for df in (dp, dy):
         assert np.isfinite(df.to_numpy()).all()

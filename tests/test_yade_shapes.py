@@ -13,6 +13,7 @@ import json
 import math
 import re
 import subprocess
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,7 @@ import pytest
 
 LAW = Path(__file__).resolve().parent.parent / "yade_law"
 EXAMPLES = Path("/usr/share/doc/yade/examples")
+import conftest  # noqa: E402
 from conftest import needs_engine, skip_engine  # noqa: E402
 
 pytestmark = needs_engine("yade")
@@ -32,7 +34,6 @@ sys.path.insert(0, {law!r})
 from stickslip_yade import stickslip_engines, stickslip_material
 from yade import *
 from yade import utils
-scene, mode = sys.argv[1], sys.argv[2]
 KN, KS, MU, R, DELTA = {kn!r}, {ks!r}, {mu!r}, {r!r}, {delta!r}
 if mode == "native":  # the same normal law, YADE's own shear spring and Coulomb limit
     mat = O.materials.append(ViscElMat(kn=2 * KN, cn=0.0, ks=2 * KS, cs=0.0, frictionAngle=math.atan(MU), density=2600))
@@ -100,8 +101,39 @@ for steps, vel in plan:
                 fn, ft, slipped, _ = stickslip_law.contact(I.id1, I.id2)
                 row[f"{{I.id1}}-{{I.id2}}"] = [fn, list(ft), slipped, twist, arm]
         log.append(row)
-print("RESULT " + json.dumps(log))
 """
+
+
+# Runs a case's script once per case in ONE YADE process, the scene reset before each
+# (O.reset()): a YADE process costs ~1.2 s of CPU to start, more than most of these cases.
+# Each case runs in a copy of the namespace YADE gives a script (its classes: Vector3, ...)
+# with the case's names set (`case`, or `scene` and `mode`); what it leaves in the variable
+# named third on the command line is the case's result.
+BATCH = """
+import sys, json
+BASE = dict(globals())
+CASES, CODE, RESULT_NAME = json.loads(sys.argv[1]), sys.argv[2], sys.argv[3]
+out = []
+for names in CASES:
+    O.reset()
+    space = dict(BASE, **names)
+    exec(compile(open(CODE).read(), CODE, "exec"), space)
+    out.append(space[RESULT_NAME])
+print("RESULT " + json.dumps(out))
+"""
+
+
+def batch(name, code, cases, result_name):
+    """{case: result} of `code` run for every case of `cases` (dicts of names) in one YADE
+    process, once per test session (conftest.shared_result)."""
+    def make():
+        folder = Path(tempfile.mkdtemp(prefix=name, dir=conftest.SHARED))
+        (folder / "case.py").write_text(code)
+        (folder / "batch.py").write_text(BATCH)
+        got = yade(folder, folder / "batch.py", json.dumps(cases), folder / "case.py", result_name)
+        return [json.dumps(c, sort_keys=True) for c in cases], got
+    keys, got = conftest.shared_result(name, code + json.dumps(cases) + result_name, make)
+    return dict(zip(keys, got))
 
 
 def yade(tmp_path, script, *args, timeout=600):
@@ -121,12 +153,14 @@ def longest_stick(flags):
     return best + 1
 
 
-@pytest.mark.parametrize("scene", ["spheres", "spheres_rolling", "facet", "facet_translating", "facet_rotating",
-                                   "periodic", "clump"])
-def test_reproduces_native_cundall_strack(tmp_path, scene):
-    script = tmp_path / "scene.py"
-    script.write_text(SCENE.format(law=str(LAW), kn=KN, ks=KS, mu=MU, r=R, delta=DELTA, dt=DT))
-    native, law = yade(tmp_path, script, scene, "native"), yade(tmp_path, script, scene, "law")
+SCENES = ["spheres", "spheres_rolling", "facet", "facet_translating", "facet_rotating", "periodic", "clump"]
+
+
+@pytest.mark.parametrize("scene", SCENES)
+def test_reproduces_native_cundall_strack(scene):
+    runs = batch("cundall-strack", SCENE.format(law=str(LAW), kn=KN, ks=KS, mu=MU, r=R, delta=DELTA, dt=DT),
+                 [{"scene": s, "mode": m} for s in SCENES for m in ("native", "law")], "log")
+    native, law = (runs[json.dumps({"mode": m, "scene": scene}, sort_keys=True)] for m in ("native", "law"))
     assert len(native) == len(law) == 700
     fmax = MU * KN * DELTA * 1.01  # the largest friction force: mu*Fn, Fn ~ Kn*delta
     keys = set().union(*native)
@@ -166,7 +200,6 @@ sys.path.insert(0, {law!r})
 from stickslip_yade import stickslip_engines, stickslip_material, stickslip_runner, insert_stickslip
 from yade import *
 from yade import utils, geom
-case = sys.argv[1]
 mat = O.materials.append(stickslip_material(1e4, 0.5))
 O.bodies.append(geom.facetBox((0, 0, 0), (0.05, 0.05, 0.05), material=mat))
 for k in range(3):
@@ -205,13 +238,13 @@ O.dt = 1e-5
 try:
     for _ in range(300):
         O.step()
-    print("RESULT " + json.dumps(None))
+    error = None
 except RuntimeError:
-    print("RESULT " + json.dumps(stickslip_law.error))
+    error = stickslip_law.error
 """
 
 
-@pytest.mark.parametrize("case,words", [
+REFUSALS = [
     ("no_facet_functor", ["Facet", "no Ig2 functor for Facet-Sphere", "pass through"]),
     ("no_facet_bound", ["Facet", "no Bo1_Facet_Aabb"]),
     ("runner_after_newton", ["after the InteractionLoop and before NewtonIntegrator"]),
@@ -220,11 +253,15 @@ except RuntimeError:
     ("unsupported_shape", ["is a Polyhedra", "handles Sphere, Facet, Wall, Box"]),
     ("engine_added_later", ["no Ig2 functor for Facet-Sphere"]),
     ("fine", None),
-])
-def test_what_the_law_cannot_handle_is_refused_naming_it(tmp_path, case, words):
-    script = tmp_path / "refuse.py"
-    script.write_text("import json\n" + REFUSE.format(law=str(LAW)))
-    error = yade(tmp_path, script, case)
+]
+
+
+@pytest.mark.parametrize("case,words", REFUSALS)
+def test_what_the_law_cannot_handle_is_refused_naming_it(case, words):
+    """Each case in a scene of its own (the batch resets the scene between them), the
+    refusal at the first step that meets it."""
+    errors = batch("refusals", REFUSE.format(law=str(LAW)), [{"case": c} for c, _ in REFUSALS], "error")
+    error = errors[json.dumps({"case": case})]
     if words is None:
         assert error is None
         return

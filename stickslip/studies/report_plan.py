@@ -12,16 +12,26 @@ import math
 from . import friction_speed, precision, thresholds
 from .. import scene as scene_mod
 
-# The engines run each ladder from the scene's dt up (factors >= 1); pyref, the reference,
-# runs it all. Below the scene's dt an engine's error is pyref's (the engine tests hold
-# them equal at equal dt: LIGGGHTS to round-off, YADE within its half-kick start
+# The engines run each ladder from the scene's dt up (factors >= 1); the reference engine
+# runs it all. Below the scene's dt an engine's error is the reference's (the engine tests
+# hold them equal at equal dt: LIGGGHTS to round-off, YADE within its half-kick start
 # difference), and its cost grows as 1/dt, which the coarser steps already show.
 ENGINE_MIN_FACTOR = 1.0
+# The reference: LIGGGHTS where it is installed (pyref's twin to round-off at equal steps,
+# and it makes the finest steps of a one- or two-grain case in a second or two where pyref
+# takes minutes: the tilt's and tray's ladders were 180 of the report's ~490 CPU s), else
+# pyref.
+REFERENCES = ("liggghts", "pyref")
+
+
+def reference(engines):
+    return next(e for e in REFERENCES if e in engines or e == "pyref")
 
 
 def plan(out, cases, engines):
-    parts = [precision.plan(case, engines, out / "precision" / case, engine_min_factor=ENGINE_MIN_FACTOR)
-             for case in cases]
+    ref = reference(engines)
+    parts = [precision.plan(case, engines, out / "precision" / case, reference=ref,
+                            engine_min_factor=ENGINE_MIN_FACTOR) for case in cases]
     parts.append(friction_speed.plan(out / "friction_speed"))
     parts.append(thresholds.plan(out / "thresholds"))
     tasks = [t for part_tasks, _ in parts for t in part_tasks]
@@ -31,19 +41,19 @@ def plan(out, cases, engines):
         for part_tasks, fin in parts:
             got.append(fin(results[k:k + len(part_tasks)]))
             k += len(part_tasks)
-        return _section(out, cases, got[: len(cases)], got[-2], got[-1])
+        return _section(out, cases, got[: len(cases)], got[-2], got[-1], ref)
 
     return tasks, finish
 
 
-def _section(out, cases, ladders, speed_rows, threshold_rows):
+def _section(out, cases, ladders, speed_rows, threshold_rows, ref):
     lines = ["", "## What accuracy costs in time", "",
              "Each case over a ladder of time steps, in both slip timings (dashed: `step`, the paper's; solid: "
-             "`exact`). Errors are measured against the exact-timing pyref run at the finest step of the ladder, "
+             f"`exact`). Errors are measured against the exact-timing {ref} run at the finest step of the ladder, "
              "a converged answer ([docs/precision.md](../docs/precision.md) shows how far it is from the dt → 0 "
-             "limit); error measures per case in `stickslip/kinds/`. pyref runs every step of the ladder; the "
-             "engines run the scene's dt and the coarser ones (below it their errors are pyref's, which the test "
-             "suite holds them to, and their cost scales as 1/dt).", ""]
+             f"limit); error measures per case in `stickslip/kinds/`. {ref} runs every step of the ladder; the "
+             f"other engines run the scene's dt and the coarser ones (below it their errors are {ref}'s, which the "
+             "test suite holds them to, and their cost scales as 1/dt).", ""]
     for case, (csv_path, orders) in zip(cases, ladders):
         d = out / "precision" / case
         rows = list(csv.DictReader(open(csv_path)))
