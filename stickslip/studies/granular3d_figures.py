@@ -84,7 +84,8 @@ def calibration_map(out, pts):
 
 def validation(out, val):
     """theta_stop of stock history (mu = 0.5) against the bed's depth: Weinhart et al.'s
-    fit (line, ± 0.7 deg band) and each engine's mean ± std over fills."""
+    fit (line, ± 0.7 deg band) and each engine's mean ± std over fills at the ramp's rates
+    (open) and at zero rate (filled: granular3d_tables.ramp_lag)."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     h = np.linspace(5, 30, 100)
@@ -93,8 +94,10 @@ def validation(out, val):
     ax.fill_between(h, w - tables.VALIDATION_TOLERANCE, w + tables.VALIDATION_TOLERANCE, color="0.9")
     for engine, color, dx in (("liggghts", "C0", -0.2), ("lammps", "C3", 0.2)):
         e = val[val.engine == engine]
-        ax.errorbar(e.depth_d + dx, e.theta_stop, yerr=e["std"], color=color, marker="o", ls="none",
-                    label=f"{engine} (mean ± std over fills)")
+        ax.errorbar(e.depth_d + dx, e.theta_stop, yerr=e["std"], color=color, marker="o", mfc="none", ls="none",
+                    label=f"{engine}, at the ramp's rates (mean ± std over fills)")
+        ax.errorbar(e.depth_d + dx, e.theta_stop_zero_rate, yerr=e.se_zero_rate, color=color, marker="o",
+                    ls="none", label=f"{engine}, at zero rate (± se)")
     ax.set_xlabel("bed depth at the stop, h (d)")
     ax.set_ylabel("θ_stop (deg)")
     ax.legend(fontsize=8)
