@@ -230,6 +230,20 @@ def _synthetic_map(tmp_path):
     return path
 
 
+def test_effective_mu_inverts_a_monotonic_stock_curve_only(tmp_path):
+    """The mu at which stock history reaches a measured angle: linear between measured mus
+    (theta_stop = 15 + 20 mu on the synthetic map: 21 is mu 0.3); none where the curve
+    turns back or does not reach the angle."""
+    from stickslip.studies import granular3d_tables as tables
+
+    pts = pd.read_csv(_synthetic_map(tmp_path), dtype={"nu_s": str})
+    assert tables.effective_mu(pts, "theta_stop", 0.0, 21.0) == pytest.approx(0.3)
+    assert math.isnan(tables.effective_mu(pts, "theta_stop", 0.0, 40.0))
+    bent = pts.copy()
+    bent.loc[(bent.mu_s == bent.mu_k) & (bent.mu_s == 0.5) & (bent.kind == "incline"), "theta_stop_mean"] = 40.0
+    assert math.isnan(tables.effective_mu(bent, "theta_stop", 0.0, 21.0))
+
+
 def test_calibrate_inverts_the_map(tmp_path, capsys):
     path = _synthetic_map(tmp_path)
     # mu_s = 0.7, mu_k = 0.5: theta_start 34, theta_stop 21, theta_heap 22.8

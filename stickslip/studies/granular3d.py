@@ -155,6 +155,11 @@ def scene_data(job, base):
             ph["rate"] *= ratio ** -1.5
             if "speed_below" in ph and ph["speed_below"] > 0.1:
                 ph["speed_below"] *= ratio ** 0.5
+            if ph.get("duration") and ph is not data["gravity_ramp"]["phase"][0]:
+                # the flow's time to develop, as its response time (measured: a 20 d bed given
+                # the 10 d bed's 10 time units flowed at 0.67 sqrt(gd), under the fast descent's
+                # end, so its slow descent began 5 deg above the stop)
+                ph["duration"] *= ratio ** 1.5
         data["time"]["duration"] *= ratio ** 2.5
     if job.rate_factor != 1.0:
         for ph in data["gravity_ramp"]["phase"]:

@@ -92,6 +92,18 @@ def curve(pts, angle, rolling, mu):
     return float(np.interp(mu, x, m)), float(np.interp(mu, x, e))
 
 
+def effective_mu(pts, angle, rolling, value):
+    """The mu at which stock history's curve of `angle` reaches `value` (linear between the
+    measured mus), or nan where the curve is not monotonic or does not reach it."""
+    kind = "heap" if angle == "theta_heap" else "incline"
+    h = _sweep(pts, kind, rolling)
+    h = h[h.mu_s == h.mu_k].sort_values("mu_s")
+    y, x = h[f"{angle}_mean"].to_numpy(float), h["mu_s"].to_numpy(float)
+    if len(y) < 2 or not np.all(np.diff(y) > 0) or not y[0] <= value <= y[-1]:
+        return math.nan
+    return float(np.interp(value, y, x))
+
+
 def _z(a, sa, b, sb):
     s = math.sqrt(sa**2 + sb**2) if np.isfinite(sa) and np.isfinite(sb) else math.nan
     return (a - b) / s if s and np.isfinite(s) else math.nan
@@ -99,7 +111,8 @@ def _z(a, sa, b, sb):
 
 def predictions(pts):
     """Each prediction of issue 39 tested on each stick-slip point: the measured angle, the
-    stock curve's at the predicted mu (and at mu_k, the naive reading), z of each."""
+    stock curve's at the predicted mu (and at mu_k, the naive reading), z of each, and the
+    mu at which stock history gives the measured angle (effective_mu)."""
     rows = []
     ss = pts[(pts.engine == "liggghts") & (pts.group == "sweep") & (pts.mu_s != pts.mu_k)]
     tests = (("theta_stop", "2mu_k-mu_s"), ("theta_heap", "2mu_k-mu_s"), ("theta_start", "mu_s"))
@@ -115,7 +128,8 @@ def predictions(pts):
             rows.append({"angle": angle, "material": p.material, "mu_s": p.mu_s, "mu_k": p.mu_k, "nu_s": p.nu_s,
                          "timing": p.timing, "rolling": p["rolling"], "measured": m, "se": e, "predicted_at": predicted,
                          "mu_predicted": mu, "stock_at_predicted": c, "stock_se": ce, "z_predicted": _z(m, e, c, ce),
-                         "stock_at_mu_k": k, "z_mu_k": _z(m, e, k, ke)})
+                         "stock_at_mu_k": k, "z_mu_k": _z(m, e, k, ke),
+                         "mu_effective": effective_mu(pts, angle, p["rolling"], m)})
     return pd.DataFrame(rows)
 
 
@@ -319,7 +333,7 @@ def summary(t, figs):
               "## Predictions", "",
               _md(t["predictions.csv"], ["angle", "material", "nu_s", "timing", "rolling", "measured", "se",
                                          "predicted_at", "mu_predicted", "stock_at_predicted", "z_predicted",
-                                         "stock_at_mu_k", "z_mu_k"]),
+                                         "stock_at_mu_k", "z_mu_k", "mu_effective"]),
               "## Hysteresis θ_start − θ_stop against μs − μk", "",
               _md(t["hysteresis.csv"], ["rolling", "nu_s", "timing", "points", "slope_deg_per_unit_mu", "slope_se",
                                         "z"]),
