@@ -117,6 +117,9 @@ def matrix(fills=FILLS, checks=True, engines=("liggghts", "lammps")):
     if checks:
         jobs += _jobs_of("incline", "liggghts", "validation", 0.5, 0.5, "0", "step", 0.0, fills, layers=DEEP_LAYERS)
         jobs += _jobs_of("incline", "liggghts", "check", 0.5, 0.5, "0", "step", 0.0, fills, rate_factor=0.5)
+        # the deep bed's lag at its own rates (two fills: ~20 CPU minutes each)
+        jobs += _jobs_of("incline", "liggghts", "check", 0.5, 0.5, "0", "step", 0.0, fills[:2], layers=DEEP_LAYERS,
+                         rate_factor=0.5)
         jobs += _jobs_of("incline", "liggghts", "check", 0.5, 0.5, "0", "step", 0.0, fills, silbert=True)
     if "lammps" in engines:
         jobs += _jobs_of("incline", "lammps", "validation", 0.5, 0.5, "0", "step", 0.0, fills)

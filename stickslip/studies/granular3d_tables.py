@@ -23,6 +23,7 @@ ANGLES = ("theta_start", "theta_stop", "theta_heap")
 # spheres of the flowing ones' size: h_stop = A d (tan d2 - tan theta) / (tan theta - tan d1).
 WEINHART = {"A": 3.836, "delta1": 17.561, "delta2": 32.257}
 VALIDATION_TOLERANCE = 0.7  # degrees (issue 39)
+DEEP_LAYERS, DEEP = 36, 20  # the deep bed: lattice layers (granular3d.DEEP_LAYERS), depth in d
 KEYS = ["kind", "engine", "group", "material", "mu_s", "mu_k", "nu_s", "timing", "rolling", "layers",
         "rate_factor", "silbert"]
 
@@ -183,13 +184,14 @@ def rolling_effect(pts):
     return pd.DataFrame(rows)
 
 
-def ramp_lag(pts):
-    """How far the ramp's theta_stop lags its zero-rate limit, from the 10 d bed of stock
-    history (mu = 0.5, LIGGGHTS) at the scene's rates and at half of them: a lag linear in
-    the rate, theta(r) = theta_0 - c r, gives theta_0 - theta(1) = 2 (theta(1/2) - theta(1)).
-    (lag, se), or (nan, nan) where the half-rate runs are not on disk."""
+def ramp_lag(pts, layers=0):
+    """How far the ramp's theta_stop lags its zero-rate limit on a bed of stock history
+    (mu = 0.5, LIGGGHTS; layers 0: the 10 d bed) measured at the ramp's rates and at half of
+    them: a lag linear in the rate, theta(r) = theta_0 - c r, gives theta_0 - theta(1) =
+    2 (theta(1/2) - theta(1)). (lag, se), or (nan, nan) where the half-rate runs are not on
+    disk."""
     inc = pts[(pts.kind == "incline") & (pts.engine == "liggghts") & (pts.material == "history_0.50") &
-              (pts["rolling"] == 0) & (pts.layers == 0) & (~pts.silbert.astype(bool))]
+              (pts["rolling"] == 0) & (pts.layers == layers) & (~pts.silbert.astype(bool))]
     full, half = inc[inc.rate_factor == 1], inc[inc.rate_factor == 0.5]
     if not len(full) or not len(half):
         return math.nan, math.nan
@@ -201,15 +203,14 @@ def ramp_lag(pts):
 def validation(pts):
     """theta_stop of stock history mu = 0.5, no rolling resistance, at both depths and on
     both engines, against Weinhart et al.'s fit at the measured depth, as measured at the
-    ramp's rates and at zero rate (the measured lag added: ramp_lag; Weinhart et al. ran at
-    fixed angles). The lag is measured on LIGGGHTS' 10 d bed; the other rows use it too
-    (LAMMPS: the same scene and rates; the 20 d bed: rates scaled by (h/h0)^-1.5 so that its
-    lag in degrees is the 10 d bed's if its flow's response time scales as h^1.5)."""
+    ramp's rates and at zero rate (the lag measured at that depth on LIGGGHTS added:
+    ramp_lag; Weinhart et al. ran at fixed angles). LAMMPS runs the same scene at the same
+    rates and takes LIGGGHTS' lag."""
     rows = []
-    lag, lag_se = ramp_lag(pts)
     h = pts[(pts.kind == "incline") & (pts.material == "history_0.50") & (pts["rolling"] == 0) &
             (pts.rate_factor == 1) & (~pts.silbert.astype(bool)) & pts.group.isin(["sweep", "validation"])]
     for _, p in h.iterrows():
+        lag, lag_se = ramp_lag(pts, p.layers)
         w = weinhart_theta_stop(p.depth_at_stop_mean)
         wn = weinhart_theta_stop(p.grains_per_area_mean)
         zero, zero_se = p.theta_stop_mean + lag, math.hypot(p.theta_stop_se, lag_se)
@@ -218,7 +219,7 @@ def validation(pts):
                      "fills": p.fills, "weinhart_at_depth": w, "difference": p.theta_stop_mean - w,
                      "z": _z(p.theta_stop_mean, p.theta_stop_se, w, 0.0),
                      "within_0.7": abs(p.theta_stop_mean - w) <= VALIDATION_TOLERANCE,
-                     "ramp_lag": lag, "theta_stop_zero_rate": zero, "se_zero_rate": zero_se,
+                     "ramp_lag": lag, "ramp_lag_se": lag_se, "theta_stop_zero_rate": zero, "se_zero_rate": zero_se,
                      "difference_zero_rate": zero - w, "z_zero_rate": _z(zero, zero_se, w, 0.0),
                      "within_0.7_zero_rate": abs(zero - w) <= VALIDATION_TOLERANCE,
                      "grains_per_area": p.grains_per_area_mean, "weinhart_at_grains_per_area": wn,
@@ -228,16 +229,19 @@ def validation(pts):
 
 
 def checks(pts):
-    """The set-up's checks against the H = 10 d stock run they vary: half rates, Silbert's kn."""
+    """The set-up's checks against the stock run they vary: half rates (10 d and 20 d beds),
+    Silbert's kn."""
     rows = []
-    inc = pts[(pts.kind == "incline") & (pts.engine == "liggghts") & (pts.material == "history_0.50") &
-              (pts["rolling"] == 0) & (pts.layers == 0)]
-    ref = inc[(inc.group == "sweep")]
-    if not len(ref):
-        return pd.DataFrame(rows)
-    ref = ref.iloc[0]
-    for what, sel in (("rates halved", inc.rate_factor == 0.5),
-                      ("Silbert's kn = 2e5, dt = 1e-4", inc.silbert.astype(bool))):
+    every = pts[(pts.kind == "incline") & (pts.engine == "liggghts") & (pts.material == "history_0.50") &
+                (pts["rolling"] == 0)]
+    for what, layers, check in (("rates halved", 0, "rate"), ("Silbert's kn = 2e5, dt = 1e-4", 0, "silbert"),
+                                (f"rates halved, {DEEP} d bed", DEEP_LAYERS, "rate")):
+        inc = every[every.layers == layers]
+        ref = inc[(inc.rate_factor == 1) & (~inc.silbert.astype(bool))]
+        sel = inc.rate_factor == 0.5 if check == "rate" else inc.silbert.astype(bool)
+        if not len(ref):
+            continue
+        ref = ref.iloc[0]
         for _, p in inc[sel].iterrows():
             for a in ("theta_stop", "theta_start"):
                 rows.append({"check": what, "angle": a, "reference": ref[f"{a}_mean"], "reference_se": ref[f"{a}_se"],
