@@ -24,61 +24,59 @@ def draw(out, t):
     return names
 
 
+def _panels(pts, height):
+    """A figure of one row per rolling resistance and one panel per angle, and its panels:
+    (row, column, axes, rolling, angle, the sweep's points of that angle's kind)."""
+    rolls = sorted(pts[pts.group == "sweep"]["rolling"].unique())
+    fig, axes = pyplot().subplots(len(rolls), 3, figsize=(12, height * len(rolls)), squeeze=False)
+    panels = [(i, j, axes[i, j], r, angle, tables._sweep(pts, "heap" if angle == "theta_heap" else "incline", r))
+              for i, r in enumerate(rolls) for j, angle in enumerate(tables.ANGLES)]
+    return fig, panels
+
+
 def curves(out, pts):
     """Stock history's angles against mu (black, ± se) and each stick-slip point drawn at its
     mu_s (up triangle), its mu_k (circle) and 2 mu_k - mu_s (down triangle); a coefficient
     "sets" an angle where its marker falls on the black curve. One row per rolling resistance."""
-    plt = pyplot()
-    rolls = sorted(pts[pts.group == "sweep"]["rolling"].unique())
-    fig, axes = plt.subplots(len(rolls), 3, figsize=(12, 3.6 * len(rolls)), squeeze=False)
-    for i, r in enumerate(rolls):
-        for j, angle in enumerate(tables.ANGLES):
-            ax = axes[i, j]
-            kind = "heap" if angle == "theta_heap" else "incline"
-            sw = tables._sweep(pts, kind, r)
-            h = sw[sw.mu_s == sw.mu_k].sort_values("mu_s")
-            ax.errorbar(h.mu_s, h[f"{angle}_mean"], yerr=h[f"{angle}_se"], color="k", marker="s", ms=4,
-                        label="stock history at μ")
-            for (nu_s, timing), (color, text) in VARIANTS.items():
-                ss = sw[(sw.mu_s != sw.mu_k) & (sw.nu_s == nu_s) & (sw.timing == timing)]
-                for k, (_, p) in enumerate(ss.iterrows()):
-                    y, e = p[f"{angle}_mean"], p[f"{angle}_se"]
-                    for x, m in ((p.mu_s, "^"), (p.mu_k, "o"), (2 * p.mu_k - p.mu_s, "v")):
-                        ax.errorbar(x, y, yerr=e, color=color, marker=m, ms=5, ls="none", alpha=0.8,
-                                    label=text if (k == 0 and m == "^") else None)
-                    ax.plot([2 * p.mu_k - p.mu_s, p.mu_s], [y, y], color=color, lw=0.5, alpha=0.5)
-            ax.set_xlabel("μ (history) / μs ▲, μk ●, 2μk − μs ▼ (stick-slip)")
-            ax.set_ylabel(f"{LABEL[angle]} (deg)")
-            ax.set_title(f"{LABEL[angle]}, rolling resistance {r:g}")
-            if i == 0 and j == 0:
-                ax.legend(fontsize=7)
+    fig, panels = _panels(pts, 3.6)
+    for i, j, ax, r, angle, sw in panels:
+        h = sw[sw.mu_s == sw.mu_k].sort_values("mu_s")
+        ax.errorbar(h.mu_s, h[f"{angle}_mean"], yerr=h[f"{angle}_se"], color="k", marker="s", ms=4,
+                    label="stock history at μ")
+        for (nu_s, timing), (color, text) in VARIANTS.items():
+            ss = sw[(sw.mu_s != sw.mu_k) & (sw.nu_s == nu_s) & (sw.timing == timing)]
+            for k, (_, p) in enumerate(ss.iterrows()):
+                y, e = p[f"{angle}_mean"], p[f"{angle}_se"]
+                for x, m in ((p.mu_s, "^"), (p.mu_k, "o"), (2 * p.mu_k - p.mu_s, "v")):
+                    ax.errorbar(x, y, yerr=e, color=color, marker=m, ms=5, ls="none", alpha=0.8,
+                                label=text if (k == 0 and m == "^") else None)
+                ax.plot([2 * p.mu_k - p.mu_s, p.mu_s], [y, y], color=color, lw=0.5, alpha=0.5)
+        ax.set_xlabel("μ (history) / μs ▲, μk ●, 2μk − μs ▼ (stick-slip)")
+        ax.set_ylabel(f"{LABEL[angle]} (deg)")
+        ax.set_title(f"{LABEL[angle]}, rolling resistance {r:g}")
+        if i == 0 and j == 0:
+            ax.legend(fontsize=7)
     return save(fig, out, "granular3d_curves.png")
 
 
 def calibration_map(out, pts):
     """The measured map: each point of the (mu_s, mu_k) plane (history on the diagonal)
     labelled with its angle, paper's nu_s; one panel per angle and rolling resistance."""
-    plt = pyplot()
-    rolls = sorted(pts[pts.group == "sweep"]["rolling"].unique())
-    fig, axes = plt.subplots(len(rolls), 3, figsize=(12, 3.8 * len(rolls)), squeeze=False)
-    for i, r in enumerate(rolls):
-        for j, angle in enumerate(tables.ANGLES):
-            ax = axes[i, j]
-            kind = "heap" if angle == "theta_heap" else "incline"
-            sw = tables._sweep(pts, kind, r)
-            sel = sw[(sw.mu_s == sw.mu_k) | ((sw.nu_s == "paper") & (sw.timing == "step"))]
-            v = sel[f"{angle}_mean"].to_numpy(float)
-            sc = ax.scatter(sel.mu_s, sel.mu_k, c=v, cmap="viridis", s=120, edgecolor="k")
-            for _, p in sel.iterrows():
-                if np.isfinite(p[f"{angle}_mean"]):
-                    ax.annotate(f"{p[f'{angle}_mean']:.1f}", (p.mu_s, p.mu_k), textcoords="offset points",
-                                xytext=(6, -10), fontsize=8)
-            ax.plot([0.15, 0.85], [0.15, 0.85], color="0.7", lw=0.5)
-            ax.plot([0.15, 0.85], [0.075, 0.425], color="0.85", lw=0.5)  # mu_k = mu_s / 2, the law's lower bound
-            ax.set_xlabel("μs")
-            ax.set_ylabel("μk")
-            ax.set_title(f"{LABEL[angle]} (deg), rolling {r:g}, paper's ν_s")
-            fig.colorbar(sc, ax=ax)
+    fig, panels = _panels(pts, 3.8)
+    for _, _, ax, r, angle, sw in panels:
+        sel = sw[(sw.mu_s == sw.mu_k) | ((sw.nu_s == "paper") & (sw.timing == "step"))]
+        v = sel[f"{angle}_mean"].to_numpy(float)
+        sc = ax.scatter(sel.mu_s, sel.mu_k, c=v, cmap="viridis", s=120, edgecolor="k")
+        for _, p in sel.iterrows():
+            if np.isfinite(p[f"{angle}_mean"]):
+                ax.annotate(f"{p[f'{angle}_mean']:.1f}", (p.mu_s, p.mu_k), textcoords="offset points",
+                            xytext=(6, -10), fontsize=8)
+        ax.plot([0.15, 0.85], [0.15, 0.85], color="0.7", lw=0.5)
+        ax.plot([0.15, 0.85], [0.075, 0.425], color="0.85", lw=0.5)  # mu_k = mu_s / 2, the law's lower bound
+        ax.set_xlabel("μs")
+        ax.set_ylabel("μk")
+        ax.set_title(f"{LABEL[angle]} (deg), rolling {r:g}, paper's ν_s")
+        fig.colorbar(sc, ax=ax)
     return save(fig, out, "granular3d_map.png")
 
 
