@@ -47,8 +47,8 @@ EXACT_PAIR = (0.8, 0.5)
 LAMMPS_PAIRS = ((0.8, 0.5), (0.5, 0.35))
 # With rolling resistance, the pairs LAMMPS repeats: mu_s 0.8 and 0.5 at the same
 # 2 mu_k - mu_s = 0.2, the largest mu_s - mu_k (0.3, 0.15), so the largest changes for rolling
-# resistance to shrink. The study's size is set by its cost (docs/granular-3d.md, "Cost"):
-# every pair and variant on both rollings would add ~5 CPU hours.
+# resistance to shrink. The study's size is set by its cost (docs/granular-3d.md, "Cost":
+# what every pair in every variant on both rollings would add).
 ROLLING_PAIRS = ((0.8, 0.5), (0.5, 0.35))
 # A deeper bed for the validation: H = 20 d (Weinhart et al.'s fit: theta_stop ~ 20.2 deg).
 DEEP_LAYERS = 36
