@@ -149,8 +149,8 @@ def build_parser():
                     help="the runs, kept for resuming (default: runs/granular3d)")
     g3.add_argument("--fills", type=_count, default=3, help="fills (random beds) per point (default: 3)")
     g3.add_argument("--only", nargs="+", help="run only the runs whose label holds one of these strings")
-    g3.add_argument("--no-checks", action="store_true", help="leave out the set-up's checks (deep bed, half "
-                                                              "rates, Silbert's kn)")
+    g3.add_argument("--no-checks", action="store_true", help="leave out the check with Silbert et al.'s stiffer "
+                                                              "contact (~1 CPU hour)")
     g3.add_argument("--engines", nargs="+", choices=("liggghts", "lammps"), default=["liggghts", "lammps"],
                     help="LAMMPS repeats the validation and two stick-slip points (default: both)")
     g3.add_argument("--jobs", type=_count, default=2, help="runs side by side (default: 2)")
