@@ -56,12 +56,12 @@ DEEP_LAYERS = 36
 # sqrt(g/d) (nu_n = 25 for a pair of m/2), dt = 1e-4 sqrt(d/g).
 SILBERT = {"kn": 2.0e5, "ks": 2.0e5 * 2 / 7, "nu_n": 25.0, "dt": 1e-4}
 
-# What a run costs, CPU seconds per grain-step (one LIGGGHTS process, 2 running at once on
-# the 2-core machine; LAMMPS measured on the same scenes), and the simulated time a run of
-# each kind lasts (the incline's ramp ends it; heap: the scene's duration). Measured on the
-# study's own runs (docs/granular-3d.md, "Cost"); only to say beforehand what a study costs.
-SECONDS_PER_GRAIN_STEP = {"liggghts": 2.2e-7, "lammps": 1.8e-7}
-INCLINE_TIME = 330.0  # time units: the ramp of a 10 d bed at the scene's rates
+# What a run costs, CPU seconds per grain-step (one process a run, 2 running at once on the
+# 2-core machine), and the simulated time an incline's ramp lasts (by bed: deep or not, and
+# the ramp's rate factor; a heap lasts its scene's duration), measured on the study's own
+# runs (docs/granular-3d/cost.csv, runs.csv): only to say beforehand what a study costs.
+SECONDS_PER_GRAIN_STEP = {"liggghts": 1.8e-7, "lammps": 1.9e-7}
+INCLINE_TIME = {(False, 1.0): 370.0, (False, 0.5): 960.0, (True, 1.0): 640.0, (True, 0.5): 1600.0}
 
 
 @dataclass
@@ -192,7 +192,7 @@ def plan(jobs, out_runs, scenes=None):
 def estimate(job, sc):
     """CPU seconds a run takes (SECONDS_PER_GRAIN_STEP, INCLINE_TIME), only to say beforehand."""
     if job.kind == "incline":
-        sim = INCLINE_TIME * ((job.layers or 18) / 18) ** 1.5 / job.rate_factor
+        sim = INCLINE_TIME[bool(job.layers), job.rate_factor]
     else:
         sim = sc.duration
     return SECONDS_PER_GRAIN_STEP[job.engine] * len(sc.grains) * sim / sc.dt
