@@ -352,6 +352,12 @@ def test_the_committed_figures_and_tables_come_from_the_committed_runs(tmp_path)
         pd.testing.assert_frame_equal(got, committed, check_exact=False, rtol=1e-9)
     for png in DOCS.glob("*.png"):
         assert (tmp_path / png.name).is_file()
+    # a study of the validation's runs alone (`--only`) has tables and no curves to draw
+    runs = pd.read_csv(DOCS / "runs.csv")
+    (tmp_path / "alone").mkdir()
+    runs[runs.group == "validation"].to_csv(tmp_path / "alone" / "runs.csv", index=False)
+    assert main(["study-3d", "--from-csv", "--out", str(tmp_path / "alone")]) == 0
+    assert (tmp_path / "alone" / "validation.csv").is_file()
 
 
 @pytest.mark.slow
