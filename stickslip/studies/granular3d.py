@@ -61,7 +61,7 @@ SILBERT = {"kn": 2.0e5, "ks": 2.0e5 * 2 / 7, "nu_n": 25.0, "dt": 1e-4}
 # the ramp's rate factor; a heap lasts its scene's duration), measured on the study's own
 # runs (docs/granular-3d/cost.csv, runs.csv): only to say beforehand what a study costs.
 SECONDS_PER_GRAIN_STEP = {"liggghts": 1.8e-7, "lammps": 1.9e-7}
-INCLINE_TIME = {(False, 1.0): 370.0, (False, 0.5): 960.0, (True, 1.0): 640.0, (True, 0.5): 1600.0}
+INCLINE_TIME = {(False, 1.0): 355.0, (False, 0.5): 960.0, (True, 1.0): 630.0, (True, 0.5): 940.0}
 
 
 @dataclass
