@@ -27,7 +27,7 @@ import numpy as np
 
 from . import RunResult
 from . import missing
-from .lammps_family import box, boundary, fmt as _fmt, gravity, integrated, run_script, vec as _vec, work_folder
+from .lammps_family import box, boundary, fmt as _fmt, integrated, run_script, vec as _vec, work_folder
 from . import ramp_script
 from .text_dumps import (atoms_dump, id_ranges, optional_dump, pair_record, recorded, run_lines, slips_dump,
                          stats_dump, timeseries)
@@ -121,7 +121,7 @@ class _Script:
         for k, w in enumerate(sc.walls):
             self._wall(k, w, args, keywords)
         if eff["gravity"]:
-            self.add(*(ramp_script.ramp_setup(sc) if sc.gravity_ramp is not None else gravity(sc)))
+            self.add(*ramp_script.gravity(sc))
         # rotation off: integrate translation only, spins stay zero
         moving, lines = integrated(sc, self.ids)
         self.moving = moving
@@ -248,5 +248,4 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     cmd = [str(launcher or LAUNCHER), "-in", "in.scene", "-log", "log.lammps", "-echo", "none", "-nocite"]
     loop_time = run_script("LAMMPS", cmd, work, scene.steps, progress, np_ranks, env={"OMP_NUM_THREADS": "1"})
     df = _timeseries(script, work)
-    steps = int(round(df["t"].iloc[-1] / scene.dt))  # a gravity ramp may end the run early
-    return RunResult(df, steps, loop_time, notes=script.notes)
+    return RunResult(df, ramp_script.steps_run(scene, df), loop_time, notes=script.notes)

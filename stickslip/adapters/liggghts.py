@@ -19,7 +19,7 @@ import numpy as np
 from . import RunResult
 from .text_dumps import full_precision as _full_precision, id_ranges as _id_ranges
 from . import missing
-from .lammps_family import box, boundary, fmt as _fmt, gravity, integrated, run_script, vec as _vec, work_folder
+from .lammps_family import box, boundary, fmt as _fmt, integrated, run_script, vec as _vec, work_folder
 from . import ramp_script
 from .text_dumps import atoms_dump, optional_dump, pair_record, recorded, run_lines, slips_dump, stats_dump, timeseries
 
@@ -155,7 +155,7 @@ class _Script:
             else:
                 self.add(f"fix move{k} all move/mesh mesh mesh{k} linear {_vec(w.velocity)}")
         if eff["gravity"]:
-            self.add(*(ramp_script.ramp_setup(sc) if sc.gravity_ramp is not None else gravity(sc)))
+            self.add(*ramp_script.gravity(sc))
         # rotation off: integrate translation only, spins stay zero (nothing paid for them)
         moving, lines = integrated(sc, self.ids)
         self.moving = moving
@@ -270,4 +270,4 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     loop_time = run_script("LIGGGHTS", cmd, work, scene.steps, progress, np_ranks,
                            serial_env={"OMPI_MCA_ess_singleton_isolated": "1"})
     df = _timeseries(script, work)
-    return RunResult(df, int(round(df["t"].iloc[-1] / scene.dt)), loop_time)  # a ramp may end it early
+    return RunResult(df, ramp_script.steps_run(scene, df), loop_time)

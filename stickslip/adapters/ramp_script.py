@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 
+from . import lammps_family
 from .lammps_family import fmt as _fmt
 
 
@@ -61,6 +62,16 @@ def run(scene, run_lines):
     the same progress lines and the control loop in place of the `run`."""
     lines = run_lines(scene.steps)
     return lines if scene.gravity_ramp is None else lines[:-1] + ramp_loop(scene)
+
+
+def gravity(scene):
+    """The script's gravity: a ramp's (ramp_setup), else lammps_family.gravity's."""
+    return ramp_setup(scene) if scene.gravity_ramp is not None else lammps_family.gravity(scene)
+
+
+def steps_run(scene, df):
+    """The steps the run made, from its last row: a ramp may end it before scene.steps."""
+    return int(round(df["t"].iloc[-1] / scene.dt))
 
 
 def ramp_setup(scene):

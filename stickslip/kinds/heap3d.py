@@ -1,7 +1,7 @@
 """Kind "heap3d": the slope of a heap left on a plate (cases/heap3d.toml, docs/granular-3d.md).
 
 From the recorded grains at the last row: the plate is the scene's fixed grains (its
-x-extent and the mean top of its spheres, as kinds.incline3d's base); the heap is the
+x-extent and the mean top of its spheres: kinds.incline3d.base_surface); the heap is the
 moving grains above the plate and within its extent. Its surface is the highest grain top
 in bins of one mean diameter along x (over the whole periodic depth); each flank's slope
 is a straight-line fit to the surface bins between FIT_LOW and FIT_HIGH of the heap's
@@ -13,6 +13,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from .incline3d import base_surface
 
 NAME = "heap3d"
 NAMES = {}
@@ -28,9 +30,8 @@ def plate(scene):
     """(x min, x max, surface height) of the plate: its fixed spheres' extent and mean top."""
     fixed = [g for g in scene.grains if g.fixed]
     x = np.array([g.position[0] for g in fixed])
-    top = np.mean([g.position[2] + g.radius for g in fixed])
     r = max(g.radius for g in fixed)
-    return float(x.min() - r), float(x.max() + r), float(top)
+    return float(x.min() - r), float(x.max() + r), base_surface(scene)
 
 
 def profile(scene, row):
@@ -66,13 +67,11 @@ def summarise(scene, df):
     xc, top = profile(scene, last)
     (left, right), height = flanks(xc, top)
     a = [math.degrees(math.atan(s)) for s in (left, right)]
-    moving = [g for g in scene.grains if not g.fixed]
     lo, hi, z0 = plate(scene)
-    on = sum(1 for g in moving if lo <= last[f"{g.name}_x"] <= hi and last[f"{g.name}_z"] > z0)
+    heap = [g for g in scene.grains if not g.fixed and lo <= last[f"{g.name}_x"] <= hi and last[f"{g.name}_z"] > z0]
     out = {"theta_heap_deg": float(np.mean(a)), "theta_left_deg": a[0], "theta_right_deg": a[1],
-           "flank_half_difference_deg": abs(a[0] - a[1]) / 2, "heap_height": height, "grains_on_plate": on}
+           "flank_half_difference_deg": abs(a[0] - a[1]) / 2, "heap_height": height, "grains_on_plate": len(heap)}
     # the heap's kinetic energy per grain (translation), in m g d: is it at rest?
-    heap = [g for g in moving if lo <= last[f"{g.name}_x"] <= hi and last[f"{g.name}_z"] > z0]
     e = sum(0.5 * scene.grain_mass(g) * sum(last[f"{g.name}_v{a}"] ** 2 for a in "xyz") for g in heap)
     mgd = np.mean([scene.grain_mass(g) for g in heap]) * float(np.linalg.norm(scene.gravity)) * 2 * np.mean(
         [g.radius for g in heap])

@@ -31,7 +31,7 @@ from ..errors import SceneError
 from . import granular3d_tables
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "granular-3d"
-ANGLES = ("theta_start", "theta_stop", "theta_heap")
+ANGLES = granular3d_tables.ANGLES
 OPTION = {"theta_start": "--theta-start", "theta_stop": "--theta-stop", "theta_heap": "--theta-heap"}
 GRID = 0.0025  # grid step in mu
 JOINT_LIMIT = 9.0  # chi2 above which targets are not reachable together (3 standard errors)
@@ -56,8 +56,7 @@ def load_map(path, rolling, nu_s="paper"):
     pts = pts[(pts.mu_s == pts.mu_k) | ((pts.nu_s == nu_s) & (pts.timing == "step"))]
     out = {}
     for angle in ANGLES:
-        kind = "heap" if angle == "theta_heap" else "incline"
-        p = pts[(pts.kind == kind) & np.isfinite(pts[f"{angle}_mean"])]
+        p = pts[(pts.kind == granular3d_tables.KIND[angle]) & np.isfinite(pts[f"{angle}_mean"])]
         mean, se = p[f"{angle}_mean"].to_numpy(float), p[f"{angle}_se"].fillna(0.0).to_numpy(float)
         if angle == "theta_stop" and np.isfinite(lag):
             mean, se = mean + lag, np.hypot(se, lag_se)

@@ -29,7 +29,7 @@ def _panels(pts, height):
     (row, column, axes, rolling, angle, the sweep's points of that angle's kind)."""
     rolls = sorted(pts[pts.group == "sweep"]["rolling"].unique())
     fig, axes = pyplot().subplots(len(rolls), 3, figsize=(12, height * len(rolls)), squeeze=False)
-    panels = [(i, j, axes[i, j], r, angle, tables._sweep(pts, "heap" if angle == "theta_heap" else "incline", r))
+    panels = [(i, j, axes[i, j], r, angle, tables._sweep(pts, tables.KIND[angle], r))
               for i, r in enumerate(rolls) for j, angle in enumerate(tables.ANGLES)]
     return fig, panels
 
@@ -40,7 +40,7 @@ def curves(out, pts):
     "sets" an angle where its marker falls on the black curve. One row per rolling resistance."""
     fig, panels = _panels(pts, 3.6)
     for i, j, ax, r, angle, sw in panels:
-        h = sw[sw.mu_s == sw.mu_k].sort_values("mu_s")
+        h = tables.history(sw)
         ax.errorbar(h.mu_s, h[f"{angle}_mean"], yerr=h[f"{angle}_se"], color="k", marker="s", ms=4,
                     label="stock history at μ")
         for (nu_s, timing), (color, text) in VARIANTS.items():

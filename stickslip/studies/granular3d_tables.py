@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 ANGLES = ("theta_start", "theta_stop", "theta_heap")
+KIND = {"theta_start": "incline", "theta_stop": "incline", "theta_heap": "heap"}  # the scene each angle is read on
 # Weinhart et al. (2012, Granular Matter 14, 531), their fit of h_stop for a base of fixed
 # spheres of the flowing ones' size: h_stop = A d (tan d2 - tan theta) / (tan theta - tan d1).
 WEINHART = {"A": 3.836, "delta1": 17.561, "delta2": 32.257}
@@ -81,11 +82,14 @@ def _sweep(pts, kind, rolling):
     return pts[(pts.kind == kind) & (pts.engine == "liggghts") & (pts.group == "sweep") & (pts["rolling"] == rolling)]
 
 
+def history(sweep):
+    """Stock history's points (mu_k = mu_s) of a sweep's points, by mu."""
+    return sweep[sweep.mu_s == sweep.mu_k].sort_values("mu_s")
+
+
 def curve(pts, angle, rolling, mu):
     """Stock history's (mean, se) of `angle` at `mu` (interpolated between measured mus)."""
-    kind = "heap" if angle == "theta_heap" else "incline"
-    h = _sweep(pts, kind, rolling)
-    h = h[h.mu_s == h.mu_k].sort_values("mu_s")
+    h = history(_sweep(pts, KIND[angle], rolling))
     m, e = h[f"{angle}_mean"].to_numpy(float), h[f"{angle}_se"].to_numpy(float)
     x = h["mu_s"].to_numpy(float)
     if not len(x) or not x.min() - 1e-9 <= mu <= x.max() + 1e-9:
@@ -96,9 +100,7 @@ def curve(pts, angle, rolling, mu):
 def effective_mu(pts, angle, rolling, value):
     """The mu at which stock history's curve of `angle` reaches `value` (linear between the
     measured mus), or nan where the curve is not monotonic or does not reach it."""
-    kind = "heap" if angle == "theta_heap" else "incline"
-    h = _sweep(pts, kind, rolling)
-    h = h[h.mu_s == h.mu_k].sort_values("mu_s")
+    h = history(_sweep(pts, KIND[angle], rolling))
     y, x = h[f"{angle}_mean"].to_numpy(float), h["mu_s"].to_numpy(float)
     if len(y) < 2 or not np.all(np.diff(y) > 0) or not y[0] <= value <= y[-1]:
         return math.nan
@@ -119,8 +121,7 @@ def predictions(pts):
     tests = (("theta_stop", "2mu_k-mu_s"), ("theta_heap", "2mu_k-mu_s"), ("theta_start", "mu_s"))
     for _, p in ss.iterrows():
         for angle, predicted in tests:
-            kind = "heap" if angle == "theta_heap" else "incline"
-            if p.kind != kind:
+            if p.kind != KIND[angle]:
                 continue
             mu = 2 * p.mu_k - p.mu_s if predicted == "2mu_k-mu_s" else p.mu_s
             c, ce = curve(pts, angle, p["rolling"], mu)
@@ -169,8 +170,7 @@ def rolling_effect(pts):
     if len(rolls) < 2:
         return pd.DataFrame(rows)
     for angle in ANGLES:
-        kind = "heap" if angle == "theta_heap" else "incline"
-        for (mat, nu_s, timing), grp in ss[ss.kind == kind].groupby(["material", "nu_s", "timing"]):
+        for (mat, nu_s, timing), grp in ss[ss.kind == KIND[angle]].groupby(["material", "nu_s", "timing"]):
             d = {}
             for _, p in grp.iterrows():
                 c, ce = curve(pts, angle, p["rolling"], p.mu_s)
