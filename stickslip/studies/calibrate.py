@@ -13,11 +13,12 @@ chi2 <= min + 1 (one standard error, the map's spread over fills). A target outs
 angles the map reaches, or targets no point of the map gives together within 3 standard
 errors, is refused in one line naming what is reachable (exit status 2).
 
-theta_stop is taken at zero rate: the study's ramp measures it while the angle falls, and
-the flow's lag puts it below the angle at which a flow at a fixed angle stops (the angle a
-user's experiment gives); the lag measured on stock history mu = 0.5 (granular3d_tables.
-ramp_lag: the 10 d bed at the ramp's rates and at half of them) is added to every point's
-theta_stop, its standard error to theirs. Where the map has no half-rate runs, as measured.
+theta_stop is taken at a fixed angle: the study's ramp measures it while the angle falls,
+and the flow's lag puts it below the angle at which a flow held at a fixed angle stops (the
+angle a user's experiment gives). The lag measured on stock history mu = 0.5, 10 d bed, is
+added to every point's theta_stop, its standard error to theirs: from beds held at fixed
+angles (validation.csv beside the map: fixed_lag, granular3d_tables.holds), else from the
+ramp at half its rates (granular3d_tables.ramp_lag, a lag linear in the rate), else none.
 """
 from __future__ import annotations
 
@@ -38,15 +39,22 @@ JOINT_LIMIT = 9.0  # chi2 above which targets are not reachable together (3 stan
 
 
 def load_map(path, rolling, nu_s="paper"):
-    """({angle: (points (n, 2), means, ses)}, (lag, its se)): the sweep at this rolling
-    resistance, history (mu_s = mu_k) and the stick-slip pairs with the chosen nu_s in the
-    step mode, theta_stop at zero rate where the map has the half-rate runs."""
+    """({angle: (points (n, 2), means, ses)}, (lag, its se, "fixed" | "ramp" | None)): the
+    sweep at this rolling resistance, history (mu_s = mu_k) and the stick-slip pairs with the
+    chosen nu_s in the step mode, theta_stop with the ramp's lag added (the module's docstring)."""
     path = Path(path)
     if not path.is_file():
         raise SceneError(f"--map {path}: not found (stickslip study-3d writes it)")
     pts = pd.read_csv(path, dtype={"nu_s": str})
     lag, lag_se = (granular3d_tables.ramp_lag(pts) if {"material", "layers", "rate_factor", "silbert"} <= set(pts)
                    else (math.nan, math.nan))
+    how = "ramp" if math.isfinite(lag) else None
+    val = path.with_name("validation.csv")
+    if val.is_file():  # the lag to beds held at fixed angles: measured, not extrapolated
+        v = pd.read_csv(val)
+        v = v[(v.engine == "liggghts") & (v.layers == 18)] if "fixed_lag" in v else v.iloc[:0]
+        if len(v) and math.isfinite(v.fixed_lag.iloc[0]):
+            lag, lag_se, how = float(v.fixed_lag.iloc[0]), float(v.fixed_lag_se.iloc[0]), "fixed"
     pts = pts[(pts["engine"] == "liggghts") & (pts["group"] == "sweep")]
     rolls = sorted(pts["rolling"].unique())
     if not any(math.isclose(rolling, r, abs_tol=1e-9) for r in rolls):
@@ -61,7 +69,7 @@ def load_map(path, rolling, nu_s="paper"):
         if angle == "theta_stop" and np.isfinite(lag):
             mean, se = mean + lag, np.hypot(se, lag_se)
         out[angle] = (p[["mu_s", "mu_k"]].to_numpy(float), mean, se)
-    return out, (lag, lag_se)
+    return out, (lag, lag_se, how)
 
 
 def surfaces(m):
@@ -122,7 +130,7 @@ def main(args):
     targets = {a: getattr(args, a) for a in ANGLES if getattr(args, a) is not None}
     if len(targets) < 2:
         raise SceneError("calibrate: give at least two of --theta-start, --theta-stop, --theta-heap (degrees)")
-    m, (lag, lag_se) = load_map(args.map or DOCS / "points.csv", args.rolling)
+    m, (lag, lag_se, how) = load_map(args.map or DOCS / "points.csv", args.rolling)
     r = solve(targets, m)
     (s0, s1), (k0, k1) = r["mu_s_range"], r["mu_k_range"]
     print(f"mu_s = {r['mu_s']:.3f} (one standard error: {s0:.3f} to {s1:.3f})")
@@ -131,6 +139,9 @@ def main(args):
     print("the map there: " + ", ".join(f"{a} {v:.1f} +- {e:.1f} deg" for a, (v, e) in r["angles"].items())
           + f" (chi2 {r['chi2']:.2f}); rolling resistance {args.rolling:g}, the paper's nu_s (0.8 nu_n), step mode;"
           " the scenes of docs/granular-3d.md")
-    print(f"theta_stop at zero rate: the ramp's value + {lag:.1f} +- {lag_se:.1f} deg (its lag, measured)"
-          if math.isfinite(lag) else "theta_stop as the ramp measured it (the map has no half-rate runs)")
+    print({"fixed": f"theta_stop at a fixed angle: the ramp's value + {lag:.1f} +- {lag_se:.1f} deg (its lag to beds "
+                    "held at fixed angles, measured)",
+           "ramp": f"theta_stop at zero rate: the ramp's value + {lag:.1f} +- {lag_se:.1f} deg (its lag, from half "
+                   "rates)",
+           None: "theta_stop as the ramp measured it (the map has no measure of the ramp's lag)"}[how])
     return r

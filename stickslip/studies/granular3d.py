@@ -55,6 +55,17 @@ DEEP_LAYERS = 36
 # Silbert et al.'s own contact for the stiffness check: kn = 2e5 m g/d, gamma_n = 50
 # sqrt(g/d) (nu_n = 25 for a pair of m/2), dt = 1e-4 sqrt(d/g).
 SILBERT = {"kn": 2.0e5, "ks": 2.0e5 * 2 / 7, "nu_n": 25.0, "dt": 1e-4}
+# The validation at fixed angles (cases/incline3d_hold.toml: a flowing bed held at one angle,
+# as Weinhart et al. ran theirs): the held angles (deg) by the bed's lattice layers, 0.5 deg
+# apart around where the ramp put each bed's stop (its zero-rate estimate; the 20 d bed's
+# 20.75 splits the step where all three fills went from stopping to flowing), and how long a
+# bed is held (time units) before it counts as flowing; the deeper bed responds (h/h0)^1.5 slower.
+HOLD_ANGLES = {18: (21.0, 21.5, 22.0, 22.5, 23.0), DEEP_LAYERS: (19.5, 20.0, 20.5, 20.75, 21.0)}
+# LAMMPS holds each bed at the angles of the 0.5-deg steps around LIGGGHTS' stops (the
+# 10 d bed's fills stopped at 21.5 or 22.0 deg and flowed at 22.0 or 22.5; the 20 d bed's at
+# 20.5 and 21.0): what it costs (a 20 d run ~10 CPU minutes) kept to its validation
+LAMMPS_HOLD_ANGLES = {18: (21.5, 22.0, 22.5), DEEP_LAYERS: (20.5, 21.0)}
+HOLD_TIME = {18: 400.0, DEEP_LAYERS: 600.0}
 
 # What a run costs, CPU seconds per grain-step (one process a run, 2 running at once on the
 # 2-core machine), and the simulated time an incline's ramp lasts (by bed: deep or not, and
@@ -68,7 +79,7 @@ INCLINE_TIME = {(False, 1.0): 355.0, (False, 0.5): 960.0, (True, 1.0): 630.0, (T
 class Job:
     """One run of the study: its folder label, the scene file, what changes in it, the engine."""
     label: str
-    kind: str  # "incline" | "heap"
+    kind: str  # "incline" | "heap" | "hold"
     engine: str
     group: str  # "sweep" | "validation" | "check" | "engines"
     material: str  # history_0.50 | ss_0.80_0.50 ...
@@ -81,6 +92,7 @@ class Job:
     layers: int | None = None  # the incline's lattice layers (None: the scene's)
     rate_factor: float = 1.0
     silbert: bool = False
+    hold: float | None = None  # the held angle, deg (kind "hold")
     data: dict = field(default_factory=dict)
 
 
@@ -93,7 +105,7 @@ def _jobs_of(kind, engine, group, mu_s, mu_k, nu_s, timing, rolling, fills, **mo
     for fill in fills:
         mat = material_label(mu_s, mu_k)
         variant = "" if mu_s == mu_k else f"_nus{nu_s}_{timing}"
-        extra = "".join(f"_{k}{v}" for k, v in sorted(more.items()) if k in ("layers", "rate_factor") and v) + (
+        extra = "".join(f"_{k}{v}" for k, v in sorted(more.items()) if k in ("layers", "rate_factor", "hold") and v) + (
             "_silbert" if more.get("silbert") else "")
         label = f"{kind}_{engine}_{mat}{variant}_roll{rolling:g}{extra}_fill{fill}"
         out.append(Job(label, kind, engine, group, mat, mu_s, mu_k, nu_s, timing, rolling, fill, **more))
@@ -121,6 +133,12 @@ def matrix(fills=FILLS, checks=True, engines=("liggghts", "lammps")):
     jobs += _jobs_of("incline", "liggghts", "validation", 0.5, 0.5, "0", "step", 0.0, fills, rate_factor=0.5)
     jobs += _jobs_of("incline", "liggghts", "validation", 0.5, 0.5, "0", "step", 0.0, fills[:2], layers=DEEP_LAYERS,
                      rate_factor=0.5)
+    # and at fixed angles, with no ramp and so no lag: does a flowing bed stop at each?
+    for engine, held in (("liggghts", HOLD_ANGLES), ("lammps", LAMMPS_HOLD_ANGLES)):
+        for layers, angles in held.items():
+            for angle in angles if engine == "liggghts" or engine in engines else ():
+                jobs += _jobs_of("hold", engine, "validation", 0.5, 0.5, "0", "step", 0.0, fills,
+                                 layers=layers if layers == DEEP_LAYERS else None, hold=angle)
     if checks:  # Silbert et al.'s own stiffness and step: ~18 CPU minutes a fill
         jobs += _jobs_of("incline", "liggghts", "check", 0.5, 0.5, "0", "step", 0.0, fills, silbert=True)
     if "lammps" in engines:
@@ -130,7 +148,7 @@ def matrix(fills=FILLS, checks=True, engines=("liggghts", "lammps")):
     return jobs
 
 
-SCENES = {"incline": "incline3d", "heap": "heap3d"}
+SCENES = {"incline": "incline3d", "heap": "heap3d", "hold": "incline3d_hold"}
 
 
 def scene_data(job, base):
@@ -166,12 +184,26 @@ def scene_data(job, base):
                 # end, so its slow descent began 5 deg above the stop)
                 ph["duration"] *= ratio ** 1.5
         data["time"]["duration"] *= ratio ** 2.5
+    if job.hold is not None:
+        _hold(data, job.hold, HOLD_TIME[job.layers or base["lattice"][0]["counts"][2]])
     if job.rate_factor != 1.0:
         for ph in data["gravity_ramp"]["phase"]:
             ph["rate"] *= job.rate_factor
         data["time"]["duration"] /= job.rate_factor
     data["name"] = f"{base['name']}_{job.label}"
     return data
+
+
+def _hold(data, angle, hold_time):
+    """cases/incline3d_hold.toml's phases brought to `angle`: the descent (phase 3) lasts until
+    it gets there, and the run ends `hold_time` after the hold begins. A deeper bed's rates and
+    durations are scaled alike above, so the angles the phases reach do not change."""
+    up, down = data["gravity_ramp"]["phase"][1], data["gravity_ramp"]["phase"][3]
+    top = up["rate"] * up["duration"]
+    if not 0 < angle < top:
+        raise SceneError(f"held angle {angle:g} deg: must be in (0, {top:g}) (the phases' highest angle)")
+    down["duration"] = (top - angle) / -down["rate"]
+    data["time"]["duration"] = sum(ph["duration"] for ph in data["gravity_ramp"]["phase"][:4]) + hold_time
 
 
 def plan(jobs, out_runs, scenes=None):
@@ -193,6 +225,8 @@ def estimate(job, sc):
     """CPU seconds a run takes (SECONDS_PER_GRAIN_STEP, INCLINE_TIME), only to say beforehand."""
     if job.kind == "incline":
         sim = INCLINE_TIME[bool(job.layers), job.rate_factor]
+    elif job.kind == "hold":  # at most: a bed that stops ends its run
+        sim = sc.duration
     else:
         sim = sc.duration
     return SECONDS_PER_GRAIN_STEP[job.engine] * len(sc.grains) * sim / sc.dt
@@ -221,7 +255,7 @@ def run_one(job, sc, data, folder, keep_engine_files=False):
     if tmp.exists():
         shutil.rmtree(tmp)
     summary, df = runner.run_scene(sc, job.engine, tmp, progress=False, write_timeseries=False)
-    if job.kind == "incline":
+    if job.kind in ("incline", "hold"):
         keep = df[["t", "tilt", "phase", "com_z", "vcm_x", "vcm_y", "vcm_z", "ekin"]].copy()
         keep.insert(3, "speed", incline3d.downhill_speed(sc, df))
         keep.to_csv(tmp / "series.csv", index=False)

@@ -83,7 +83,8 @@ def calibration_map(out, pts):
 def validation(out, val):
     """theta_stop of stock history (mu = 0.5) against the bed's depth: Weinhart et al.'s
     fit (line, ± 0.7 deg band) and each engine's mean ± std over fills at the ramp's rates
-    (open) and at zero rate (filled: granular3d_tables.ramp_lag)."""
+    (open), at zero rate (filled circles: granular3d_tables.ramp_lag) and held at fixed angles
+    (squares: granular3d_tables.holds)."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     h = np.linspace(5, 30, 100)
@@ -96,6 +97,9 @@ def validation(out, val):
                     label=f"{engine}, at the ramp's rates (mean ± std over fills)")
         ax.errorbar(e.depth_d + dx, e.theta_stop_zero_rate, yerr=e.se_zero_rate, color=color, marker="o",
                     ls="none", label=f"{engine}, at zero rate (± se)")
+        if "theta_stop_fixed" in e and np.isfinite(e.theta_stop_fixed).any():
+            ax.errorbar(e.fixed_depth_d + dx, e.theta_stop_fixed, yerr=e.se_fixed, color=color, marker="s",
+                        ls="none", label=f"{engine}, held at fixed angles (± se)")
     ax.set_xlabel("bed depth at the stop, h (d)")
     ax.set_ylabel("θ_stop (deg)")
     ax.legend(fontsize=8)

@@ -51,7 +51,13 @@ def write_runs(finished, out):
                      # Silbert et al.'s measure of a bed's depth: flowing grains per d^2 of the base
                      "grains_per_area": len(sc.moving_grains()) / area,
                      "heap_flank_half_difference": s.get("flank_half_difference_deg", math.nan),
-                     "heap_ekin_per_grain_mgd": s.get("heap_ekin_per_grain_mgd", math.nan)})
+                     "heap_ekin_per_grain_mgd": s.get("heap_ekin_per_grain_mgd", math.nan),
+                     # the validation at fixed angles (kind hold3d): the held angle, did the bed stop, when
+                     "hold_angle": s.get("theta_hold_deg", math.nan),  # as run: within one interval's turn
+                     "stopped": s.get("stopped", math.nan), "time_to_stop": s.get("time_to_stop_s", math.nan),
+                     "speed_at_end": s.get("speed_at_end", math.nan), "speed_trend": s.get("speed_trend", math.nan)})
+        if job.kind == "hold" and s.get("stopped") == 1.0:
+            rows[-1]["depth_at_stop"] = s["depth_at_end"]
     out.mkdir(parents=True, exist_ok=True)
     runs = pd.DataFrame(rows)
     runs.to_csv(out / "runs.csv", index=False)
@@ -59,8 +65,9 @@ def write_runs(finished, out):
 
 
 def points(runs):
-    """One row per point of the study: the mean, std, se and n of every angle over fills."""
-    runs = runs.copy()
+    """One row per point of the study: the mean, std, se and n of every angle over fills
+    (the runs at fixed angles are holds' rows, not points)."""
+    runs = runs[runs.kind != "hold"].copy()
     for k in ("layers", "rate_factor", "silbert"):
         runs[k] = runs[k].fillna(0)
     rows = []
@@ -200,12 +207,59 @@ def ramp_lag(pts, layers=0):
             2 * math.hypot(h.theta_stop_se, f.theta_stop_se))
 
 
-def validation(pts):
+# The held angles are at most 0.5 deg apart: a fill's theta_stop is the middle of the step
+# between the highest angle at which its bed stopped and the lowest at which it still flowed,
+# within half the step. The fills share the grid, so the grid's error does not average out
+# over fills: it is added to their standard error as a uniform spread's, step / sqrt(12).
+HOLD_STEP = 0.5
+
+
+def holds(runs):
+    """theta_stop at fixed angles, one row per engine, bed (lattice layers) and fill: the highest held
+    angle at which the bed stopped, the lowest at which it still flowed, their middle
+    (theta_stop), whether every stop lies below every flow (ordered), the bed's depth at its
+    stops and the longest time a stop took (against the hold's length: a bed slower to stop
+    than the hold counts as flowing, so the beds that flowed to the end say whether they were
+    still slowing down: hold3d's speed_trend)."""
+    rows = []
+    h = runs[runs.kind == "hold"]
+    for (engine, layers, fill), grp in h.groupby(["engine", "layers", "fill"]):
+        stopped, flowing = grp[grp.stopped == 1], grp[grp.stopped == 0]
+        lo = float(stopped.hold_angle.max()) if len(stopped) else math.nan
+        hi = float(flowing.hold_angle.min()) if len(flowing) else math.nan
+        ordered = bool(np.isfinite(lo) and np.isfinite(hi) and lo < hi)
+        rows.append({"engine": engine, "layers": int(layers) or 18, "fill": int(fill), "angles": len(grp),
+                     "highest_stopped": lo, "lowest_flowing": hi, "ordered": ordered,
+                     "theta_stop": (lo + hi) / 2 if ordered and hi - lo < 1.5 * HOLD_STEP else math.nan,  # next angles
+                     "depth_d": float(stopped.depth_at_stop.mean()) if len(stopped) else math.nan,
+                     "longest_stop": float(stopped.time_to_stop.max()) if len(stopped) else math.nan,
+                     # the flowing beds' least speed_trend: near 1, none was still slowing down
+                     "flowing_least_trend": float(flowing.speed_trend.min()) if len(flowing) else math.nan})
+    return pd.DataFrame(rows)
+
+
+def fixed_angle(hold_rows, layers, engine="liggghts"):
+    """(theta_stop, se, fills, depth) at fixed angles for a bed on an engine: the mean over its
+    fills, se their spread's with the grid's step / sqrt(12) added (the fills' mean step,
+    HOLD_STEP); nans when not run."""
+    if hold_rows is None or not len(hold_rows):
+        return math.nan, math.nan, 0, math.nan
+    sel = hold_rows[(hold_rows.engine == engine) & (hold_rows.layers == layers) & np.isfinite(hold_rows.theta_stop)]
+    v = sel.theta_stop.to_numpy(float)
+    if not len(v):
+        return math.nan, math.nan, 0, math.nan
+    spread = v.std(ddof=1) / math.sqrt(len(v)) if len(v) > 1 else math.nan
+    step = float((sel.lowest_flowing - sel.highest_stopped).mean())
+    return float(v.mean()), math.hypot(spread, step / math.sqrt(12)), len(v), float(sel.depth_d.mean())
+
+
+def validation(pts, hold_rows=None):
     """theta_stop of stock history mu = 0.5, no rolling resistance, at both depths and on
     both engines, against Weinhart et al.'s fit at the measured depth, as measured at the
     ramp's rates and at zero rate (the lag measured at that depth on LIGGGHTS added:
-    ramp_lag; Weinhart et al. ran at fixed angles). LAMMPS runs the same scene at the same
-    rates and takes LIGGGHTS' lag."""
+    ramp_lag; Weinhart et al. ran at fixed angles), and at fixed angles (holds: LIGGGHTS,
+    the lag it shows, theta_fixed - theta_ramp, taken by LAMMPS, which runs the same scene at
+    the same rates, as it takes the zero-rate lag)."""
     rows = []
     h = pts[(pts.kind == "incline") & (pts.material == "history_0.50") & (pts["rolling"] == 0) &
             (pts.rate_factor == 1) & (~pts.silbert.astype(bool)) & pts.group.isin(["sweep", "validation"])]
@@ -225,7 +279,43 @@ def validation(pts):
                      "grains_per_area": p.grains_per_area_mean, "weinhart_at_grains_per_area": wn,
                      "difference_grains_per_area": p.theta_stop_mean - wn,
                      "within_0.7_grains_per_area": abs(p.theta_stop_mean - wn) <= VALIDATION_TOLERANCE})
+        rows[-1].update(_fixed_columns(pts, hold_rows, p))
+    # a bed an engine held at fixed angles and did not ramp (LAMMPS' 20 d bed): its own row
+    ramped = {(r["engine"], r["layers"]) for r in rows}
+    for engine, layers in ([] if hold_rows is None else
+                           sorted(set(zip(hold_rows.engine, hold_rows.layers)) - ramped)):
+        fixed, fixed_se, n, depth = fixed_angle(hold_rows, layers, engine)
+        w = weinhart_theta_stop(depth) if np.isfinite(depth) else math.nan
+        rows.append({"engine": engine, "layers": int(layers), "fixed_fills": n, "fixed_depth_d": depth,
+                     "theta_stop_fixed": fixed, "se_fixed": fixed_se, "weinhart_at_fixed_depth": w,
+                     "difference_fixed": fixed - w, "z_fixed": _z(fixed, fixed_se, w, 0.0),
+                     "within_0.7_fixed": bool(abs(fixed - w) <= VALIDATION_TOLERANCE)})
     return pd.DataFrame(rows)
+
+
+def _fixed_columns(pts, hold_rows, p):
+    """The validation's columns at fixed angles for point p (a ramp's row): the engine's own
+    holds, else (an engine that held no bed there) its ramp plus LIGGGHTS' lag (fixed - ramp)
+    on that bed."""
+    layers = int(p.layers) or 18
+    fixed, fixed_se, n, depth = fixed_angle(hold_rows, layers)
+    lig = pts[(pts.kind == "incline") & (pts.engine == "liggghts") & (pts.material == "history_0.50") &
+              (pts["rolling"] == 0) & (pts.layers == p.layers) & (pts.rate_factor == 1) & (~pts.silbert.astype(bool))]
+    lag, lag_se = math.nan, math.nan
+    if len(lig) and np.isfinite(fixed):
+        lag, lag_se = fixed - lig.iloc[0].theta_stop_mean, math.hypot(fixed_se, lig.iloc[0].theta_stop_se)
+    if p.engine != "liggghts":
+        fixed, fixed_se, n, depth = fixed_angle(hold_rows, layers, p.engine)
+        if n:  # its own lag
+            lag, lag_se = fixed - p.theta_stop_mean, math.hypot(fixed_se, p.theta_stop_se)
+        else:
+            fixed, fixed_se = p.theta_stop_mean + lag, math.hypot(p.theta_stop_se, lag_se)
+            depth = p.depth_at_stop_mean
+    w = weinhart_theta_stop(depth) if np.isfinite(depth) else math.nan
+    return {"fixed_fills": n, "fixed_depth_d": depth, "fixed_lag": lag, "fixed_lag_se": lag_se,
+            "theta_stop_fixed": fixed, "se_fixed": fixed_se, "weinhart_at_fixed_depth": w,
+            "difference_fixed": fixed - w, "z_fixed": _z(fixed, fixed_se, w, 0.0),
+            "within_0.7_fixed": bool(abs(fixed - w) <= VALIDATION_TOLERANCE)}
 
 
 def checks(pts):
@@ -291,9 +381,12 @@ def write_tables(out):
     out = Path(out)
     runs = pd.read_csv(out / "runs.csv")
     pts = points(runs)
+    hold_rows = holds(runs) if "hold_angle" in runs else None
     tables = {"points.csv": pts, "predictions.csv": predictions(pts), "hysteresis.csv": hysteresis(pts),
-              "rolling.csv": rolling_effect(pts), "validation.csv": validation(pts), "checks.csv": checks(pts),
+              "rolling.csv": rolling_effect(pts), "validation.csv": validation(pts, hold_rows), "checks.csv": checks(pts),
               "engines.csv": engines(pts), "cost.csv": cost(runs)}
+    if hold_rows is not None:
+        tables["holds.csv"] = hold_rows
     for name, t in tables.items():
         t.to_csv(out / name, index=False)
     return tables
@@ -332,6 +425,13 @@ def summary(t, figs):
                                         "weinhart_at_depth", "difference", "z", "within_0.7", "ramp_lag",
                                         "theta_stop_zero_rate", "difference_zero_rate", "z_zero_rate",
                                         "within_0.7_zero_rate", "grains_per_area", "difference_grains_per_area"]),
+              "### At fixed angles (a flowing bed held at each angle: did it stop?)", "",
+              _md(t["validation.csv"], ["engine", "layers", "fixed_fills", "fixed_depth_d", "theta_stop_fixed",
+                                        "se_fixed", "weinhart_at_fixed_depth", "difference_fixed", "z_fixed",
+                                        "within_0.7_fixed", "fixed_lag", "fixed_lag_se"]
+                  if "theta_stop_fixed" in t["validation.csv"] else ["engine"]),
+              _md(t.get("holds.csv"), ["engine", "layers", "fill", "angles", "highest_stopped", "lowest_flowing", "ordered",
+                                       "theta_stop", "depth_d", "longest_stop", "flowing_least_trend"]),
               "## Checks of the set-up", "",
               _md(t["checks.csv"], ["check", "angle", "reference", "checked", "difference", "z"]),
               "## Predictions", "",
