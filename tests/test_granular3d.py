@@ -377,6 +377,12 @@ def test_the_committed_figures_and_tables_come_from_the_committed_runs(tmp_path)
     runs[runs.group == "validation"].to_csv(tmp_path / "alone" / "runs.csv", index=False)
     assert main(["study-3d", "--from-csv", "--out", str(tmp_path / "alone")]) == 0
     assert (tmp_path / "alone" / "validation.csv").is_file()
+    # and of the held beds alone: no ramp, so only the fixed-angle columns
+    (tmp_path / "held").mkdir()
+    runs[runs.kind == "hold"].to_csv(tmp_path / "held" / "runs.csv", index=False)
+    assert main(["study-3d", "--from-csv", "--out", str(tmp_path / "held")]) == 0
+    v = pd.read_csv(tmp_path / "held" / "validation.csv")
+    assert len(v) == 4 and v.theta_stop_fixed.notna().all() and "theta_stop_zero_rate" not in v
 
 
 @pytest.mark.slow

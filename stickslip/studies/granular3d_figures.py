@@ -93,10 +93,11 @@ def validation(out, val):
     ax.fill_between(h, w - tables.VALIDATION_TOLERANCE, w + tables.VALIDATION_TOLERANCE, color="0.9")
     for engine, color, dx in (("liggghts", "C0", -0.2), ("lammps", "C3", 0.2)):
         e = val[val.engine == engine]
-        ax.errorbar(e.depth_d + dx, e.theta_stop, yerr=e["std"], color=color, marker="o", mfc="none", ls="none",
-                    label=f"{engine}, at the ramp's rates (mean ± std over fills)")
-        ax.errorbar(e.depth_d + dx, e.theta_stop_zero_rate, yerr=e.se_zero_rate, color=color, marker="o",
-                    ls="none", label=f"{engine}, at zero rate (± se)")
+        if "theta_stop" in e:  # the ramps (a study of held beds alone has none)
+            ax.errorbar(e.depth_d + dx, e.theta_stop, yerr=e["std"], color=color, marker="o", mfc="none", ls="none",
+                        label=f"{engine}, at the ramp's rates (mean ± std over fills)")
+            ax.errorbar(e.depth_d + dx, e.theta_stop_zero_rate, yerr=e.se_zero_rate, color=color, marker="o",
+                        ls="none", label=f"{engine}, at zero rate (± se)")
         if "theta_stop_fixed" in e and np.isfinite(e.theta_stop_fixed).any():
             ax.errorbar(e.fixed_depth_d + dx, e.theta_stop_fixed, yerr=e.se_fixed, color=color, marker="s",
                         ls="none", label=f"{engine}, held at fixed angles (± se)")

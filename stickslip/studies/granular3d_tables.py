@@ -82,7 +82,9 @@ def points(runs):
             row[f"{a}_n"] = len(v)
         row["fills"] = len(grp)
         rows.append(row)
-    return pd.DataFrame(rows)
+    columns = KEYS + [f"{a}_{k}" for a in ANGLES + ("depth_at_stop", "grains_per_area")
+                      for k in ("mean", "std", "se", "n")] + ["fills"]
+    return pd.DataFrame(rows, columns=columns)  # the columns even when only held beds ran
 
 
 def _sweep(pts, kind, rolling):
@@ -235,7 +237,11 @@ def holds(runs):
                      "longest_stop": float(stopped.time_to_stop.max()) if len(stopped) else math.nan,
                      # the flowing beds' least speed_trend: near 1, none was still slowing down
                      "flowing_least_trend": float(flowing.speed_trend.min()) if len(flowing) else math.nan})
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=HOLD_COLUMNS)  # the columns even when no bed was held
+
+
+HOLD_COLUMNS = ["engine", "layers", "fill", "angles", "highest_stopped", "lowest_flowing", "ordered", "theta_stop",
+                "depth_d", "longest_stop", "flowing_least_trend"]
 
 
 def fixed_angle(hold_rows, layers, engine="liggghts"):
@@ -393,7 +399,8 @@ def write_tables(out):
 
 
 def _md(df, cols, fmt=".2f"):
-    if df is None or not len(df):
+    cols = [c for c in cols if df is not None and c in df]  # a partial study has fewer
+    if df is None or not len(df) or not cols:
         return "(none measured yet)\n"
     head = "| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n"
     body = ""
