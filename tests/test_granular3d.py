@@ -258,16 +258,22 @@ def test_calibrate_inverts_the_map(tmp_path, capsys):
     assert main(["calibrate", "--theta-stop", "21", "--theta-heap", "22.8", "--map", str(path)]) == 0
 
 
-def test_calibrate_takes_theta_stop_at_zero_rate(tmp_path, capsys):
-    """With the half-rate runs in the map (stock history mu = 0.5 stopping 0.5 deg higher at
-    half rate: a lag of 1.0 deg at the ramp's rates), a target theta_stop 1 deg higher gives
-    the answer the map as measured gives."""
+def _map_with_half_rates(tmp_path):
+    """tmp_path/points.csv: the synthetic map with stock history mu = 0.5 also at half rate,
+    stopping 0.5 deg higher there (a lag of 1.0 deg at the ramp's rates)."""
     pts = pd.read_csv(_synthetic_map(tmp_path))
     pts = pts.assign(material=["history_0.50" if a == b == 0.5 else "x" for a, b in zip(pts.mu_s, pts.mu_k)],
                      layers=0, rate_factor=1.0, silbert=False)
     half = pts[(pts.material == "history_0.50") & (pts.kind == "incline")].assign(group="check", rate_factor=0.5)
     half["theta_stop_mean"] += 0.5
     pd.concat([pts, half]).to_csv(tmp_path / "points.csv", index=False)
+
+
+def test_calibrate_takes_theta_stop_at_zero_rate(tmp_path, capsys):
+    """With the half-rate runs in the map (stock history mu = 0.5 stopping 0.5 deg higher at
+    half rate: a lag of 1.0 deg at the ramp's rates), a target theta_stop 1 deg higher gives
+    the answer the map as measured gives."""
+    _map_with_half_rates(tmp_path)
     assert main(["calibrate", "--theta-start", "34", "--theta-stop", "22", "--map", str(tmp_path / "points.csv")]) == 0
     out = capsys.readouterr().out
     assert float(out.split("mu_s = ")[1].split()[0]) == pytest.approx(0.7, abs=0.005)
@@ -279,12 +285,7 @@ def test_calibrate_takes_the_lag_to_fixed_angles_before_the_half_rate_one(tmp_pa
     """With validation.csv beside the map holding the lag the held beds measured on the 10 d
     bed (1.5 deg; the half rates' 1.0 is in the map too), a target theta_stop 1.5 deg higher
     gives the answer the map as measured gives."""
-    pts = pd.read_csv(_synthetic_map(tmp_path))
-    pts = pts.assign(material=["history_0.50" if a == b == 0.5 else "x" for a, b in zip(pts.mu_s, pts.mu_k)],
-                     layers=0, rate_factor=1.0, silbert=False)
-    half = pts[(pts.material == "history_0.50") & (pts.kind == "incline")].assign(group="check", rate_factor=0.5)
-    half["theta_stop_mean"] += 0.5
-    pd.concat([pts, half]).to_csv(tmp_path / "points.csv", index=False)
+    _map_with_half_rates(tmp_path)
     pd.DataFrame({"engine": ["liggghts", "liggghts", "lammps"], "layers": [36, 18, 18],
                   "fixed_lag": [9.0, 1.5, 7.0], "fixed_lag_se": [0.1, 0.3, 0.1]}).to_csv(tmp_path / "validation.csv")
     assert main(["calibrate", "--theta-start", "34", "--theta-stop", "22.5", "--map", str(tmp_path / "points.csv")]) == 0

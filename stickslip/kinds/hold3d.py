@@ -36,16 +36,15 @@ def summarise(scene, df):
         return {"theta_hold_deg": math.nan, "stopped": math.nan, "time_to_stop_s": math.nan, "depth_at_end": math.nan,
                 "speed_at_end": math.nan, "speed_trend": math.nan, "duration_run_s": float(df["t"].iat[-1])}
     end = incline3d.phase_end(scene, df, phase)
-    up = -scene.gravity / np.linalg.norm(scene.gravity)
-    com = df[["com_x", "com_y", "com_z"]].to_numpy(float)[-1]
+    v = incline3d.downhill_speed(scene, df)
     return {"theta_hold_deg": math.degrees(df["tilt"].iat[rows[0]]),
             "stopped": float(end is not None),
             # the hold's first row closes its first interval: the hold began one interval earlier
             "time_to_stop_s": (float(df["t"].iat[end] - df["t"].iat[rows[0]]) + scene.output.every * scene.dt
                                if end is not None else math.nan),
-            "depth_at_end": 2.0 * (float(com @ up) - incline3d.base_surface(scene)),
-            "speed_at_end": float(incline3d.downhill_speed(scene, df.iloc[[-1]])[0]),
-            "speed_trend": _trend(incline3d.downhill_speed(scene, df.iloc[rows])) if end is None else math.nan,
+            "depth_at_end": incline3d.depth(scene, df, -1),
+            "speed_at_end": float(v[-1]),
+            "speed_trend": _trend(v[rows]) if end is None else math.nan,
             "duration_run_s": float(df["t"].iat[-1])}
 
 

@@ -40,6 +40,14 @@ def base_surface(scene):
     return float(np.mean(tops)) if tops else math.nan
 
 
+def depth(scene, df, row):
+    """The bed's depth at `row` of the series: twice the height of its centre of mass above
+    the base's surface (base_surface; a uniform bed has its centre of mass half way up)."""
+    up = -scene.gravity / np.linalg.norm(scene.gravity)
+    com = df[["com_x", "com_y", "com_z"]].to_numpy(float)[row]
+    return 2.0 * (float(com @ up) - base_surface(scene))
+
+
 def phase_end(scene, df, phase):
     """The row index at which `phase` ended on its condition, or None (it never ended)."""
     ph = df["phase"].to_numpy(int)
@@ -57,8 +65,6 @@ def phase_end(scene, df, phase):
 
 def summarise(scene, df):
     out = {}
-    up = -scene.gravity / np.linalg.norm(scene.gravity)
-    z_base = base_surface(scene)
     for key in ("stop", "start"):
         phase = scene.analysis[f"{key}_phase"]
         row = phase_end(scene, df, phase)
@@ -66,8 +72,7 @@ def summarise(scene, df):
         out[f"t_{key}_s"] = float(df["t"].iat[row]) if row is not None else math.nan
         out[f"ramp_{key}_deg_per_s"] = math.degrees(scene.gravity_ramp.phases[phase].rate)
         if key == "stop":
-            com = df[["com_x", "com_y", "com_z"]].to_numpy(float)[row] if row is not None else None
-            out["depth_at_stop"] = 2.0 * (float(com @ up) - z_base) if com is not None else math.nan
+            out["depth_at_stop"] = depth(scene, df, row) if row is not None else math.nan
     v = downhill_speed(scene, df)
     out["max_speed"] = float(np.max(v)) if len(v) else math.nan
     out["duration_run_s"] = float(df["t"].iat[-1])

@@ -134,9 +134,10 @@ def matrix(fills=FILLS, checks=True, engines=("liggghts", "lammps")):
     jobs += _jobs_of("incline", "liggghts", "validation", 0.5, 0.5, "0", "step", 0.0, fills[:2], layers=DEEP_LAYERS,
                      rate_factor=0.5)
     # and at fixed angles, with no ramp and so no lag: does a flowing bed stop at each?
-    for engine, held in (("liggghts", HOLD_ANGLES), ("lammps", LAMMPS_HOLD_ANGLES)):
-        for layers, angles in held.items():
-            for angle in angles if engine == "liggghts" or engine in engines else ():
+    held = [("liggghts", HOLD_ANGLES)] + ([("lammps", LAMMPS_HOLD_ANGLES)] if "lammps" in engines else [])
+    for engine, angles_of in held:
+        for layers, angles in angles_of.items():
+            for angle in angles:
                 jobs += _jobs_of("hold", engine, "validation", 0.5, 0.5, "0", "step", 0.0, fills,
                                  layers=layers if layers == DEEP_LAYERS else None, hold=angle)
     if checks:  # Silbert et al.'s own stiffness and step: ~18 CPU minutes a fill
@@ -225,9 +226,7 @@ def estimate(job, sc):
     """CPU seconds a run takes (SECONDS_PER_GRAIN_STEP, INCLINE_TIME), only to say beforehand."""
     if job.kind == "incline":
         sim = INCLINE_TIME[bool(job.layers), job.rate_factor]
-    elif job.kind == "hold":  # at most: a bed that stops ends its run
-        sim = sc.duration
-    else:
+    else:  # a heap; a held bed at most (one that stops ends its run)
         sim = sc.duration
     return SECONDS_PER_GRAIN_STEP[job.engine] * len(sc.grains) * sim / sc.dt
 

@@ -193,14 +193,20 @@ def rolling_effect(pts):
     return pd.DataFrame(rows)
 
 
+def stock_ramps(pts, layers, engine="liggghts"):
+    """The points of the validation's ramps on a bed (layers; 0: the 10 d bed): stock history
+    mu = 0.5, no rolling resistance, the scene's contact (not Silbert's), every rate."""
+    return pts[(pts.kind == "incline") & (pts.engine == engine) & (pts.material == "history_0.50") &
+               (pts["rolling"] == 0) & (pts.layers == layers) & (~pts.silbert.astype(bool))]
+
+
 def ramp_lag(pts, layers=0):
     """How far the ramp's theta_stop lags its zero-rate limit on a bed of stock history
     (mu = 0.5, LIGGGHTS; layers 0: the 10 d bed) measured at the ramp's rates and at half of
     them: a lag linear in the rate, theta(r) = theta_0 - c r, gives theta_0 - theta(1) =
     2 (theta(1/2) - theta(1)). (lag, se), or (nan, nan) where the half-rate runs are not on
     disk."""
-    inc = pts[(pts.kind == "incline") & (pts.engine == "liggghts") & (pts.material == "history_0.50") &
-              (pts["rolling"] == 0) & (pts.layers == layers) & (~pts.silbert.astype(bool))]
+    inc = stock_ramps(pts, layers)
     full, half = inc[inc.rate_factor == 1], inc[inc.rate_factor == 0.5]
     if not len(full) or not len(half):
         return math.nan, math.nan
@@ -291,37 +297,36 @@ def validation(pts, hold_rows=None):
     for engine, layers in ([] if hold_rows is None else
                            sorted(set(zip(hold_rows.engine, hold_rows.layers)) - ramped)):
         fixed, fixed_se, n, depth = fixed_angle(hold_rows, layers, engine)
-        w = weinhart_theta_stop(depth) if np.isfinite(depth) else math.nan
-        rows.append({"engine": engine, "layers": int(layers), "fixed_fills": n, "fixed_depth_d": depth,
-                     "theta_stop_fixed": fixed, "se_fixed": fixed_se, "weinhart_at_fixed_depth": w,
-                     "difference_fixed": fixed - w, "z_fixed": _z(fixed, fixed_se, w, 0.0),
-                     "within_0.7_fixed": bool(abs(fixed - w) <= VALIDATION_TOLERANCE)})
+        rows.append({"engine": engine, "layers": int(layers), "fixed_fills": n,
+                     **_fixed_against_weinhart(fixed, fixed_se, depth)})
     return pd.DataFrame(rows)
+
+
+def _fixed_against_weinhart(fixed, fixed_se, depth):
+    """theta_stop at fixed angles (its se, the bed's depth) against Weinhart et al.'s fit there."""
+    w = weinhart_theta_stop(depth) if np.isfinite(depth) else math.nan
+    return {"fixed_depth_d": depth, "theta_stop_fixed": fixed, "se_fixed": fixed_se, "weinhart_at_fixed_depth": w,
+            "difference_fixed": fixed - w, "z_fixed": _z(fixed, fixed_se, w, 0.0),
+            "within_0.7_fixed": bool(abs(fixed - w) <= VALIDATION_TOLERANCE)}
 
 
 def _fixed_columns(pts, hold_rows, p):
     """The validation's columns at fixed angles for point p (a ramp's row): the engine's own
-    holds, else (an engine that held no bed there) its ramp plus LIGGGHTS' lag (fixed - ramp)
-    on that bed."""
+    holds and the lag they show (fixed - ramp); an engine that held no bed there (but LIGGGHTS
+    did) takes its ramp plus LIGGGHTS' lag on that bed."""
     layers = int(p.layers) or 18
-    fixed, fixed_se, n, depth = fixed_angle(hold_rows, layers)
-    lig = pts[(pts.kind == "incline") & (pts.engine == "liggghts") & (pts.material == "history_0.50") &
-              (pts["rolling"] == 0) & (pts.layers == p.layers) & (pts.rate_factor == 1) & (~pts.silbert.astype(bool))]
-    lag, lag_se = math.nan, math.nan
-    if len(lig) and np.isfinite(fixed):
-        lag, lag_se = fixed - lig.iloc[0].theta_stop_mean, math.hypot(fixed_se, lig.iloc[0].theta_stop_se)
-    if p.engine != "liggghts":
-        fixed, fixed_se, n, depth = fixed_angle(hold_rows, layers, p.engine)
-        if n:  # its own lag
-            lag, lag_se = fixed - p.theta_stop_mean, math.hypot(fixed_se, p.theta_stop_se)
-        else:
-            fixed, fixed_se = p.theta_stop_mean + lag, math.hypot(p.theta_stop_se, lag_se)
-            depth = p.depth_at_stop_mean
-    w = weinhart_theta_stop(depth) if np.isfinite(depth) else math.nan
-    return {"fixed_fills": n, "fixed_depth_d": depth, "fixed_lag": lag, "fixed_lag_se": lag_se,
-            "theta_stop_fixed": fixed, "se_fixed": fixed_se, "weinhart_at_fixed_depth": w,
-            "difference_fixed": fixed - w, "z_fixed": _z(fixed, fixed_se, w, 0.0),
-            "within_0.7_fixed": bool(abs(fixed - w) <= VALIDATION_TOLERANCE)}
+    fixed, fixed_se, n, depth = fixed_angle(hold_rows, layers, p.engine)
+    if n or p.engine == "liggghts":
+        lag, lag_se = fixed - p.theta_stop_mean, math.hypot(fixed_se, p.theta_stop_se)
+    else:
+        lig_fixed, lig_se, _, _ = fixed_angle(hold_rows, layers)
+        ramp = stock_ramps(pts, p.layers)
+        ramp = ramp[ramp.rate_factor == 1]
+        lag, lag_se = ((lig_fixed - ramp.iloc[0].theta_stop_mean, math.hypot(lig_se, ramp.iloc[0].theta_stop_se))
+                       if len(ramp) else (math.nan, math.nan))
+        fixed, fixed_se, depth = p.theta_stop_mean + lag, math.hypot(p.theta_stop_se, lag_se), p.depth_at_stop_mean
+    return {"fixed_fills": n, "fixed_depth_d": depth, "fixed_lag": lag, "fixed_lag_se": lag_se,  # the columns' order
+            **_fixed_against_weinhart(fixed, fixed_se, depth)}
 
 
 def checks(pts):
