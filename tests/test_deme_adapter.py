@@ -188,12 +188,56 @@ def test_drag_scene_as_the_engine_sees_it():
     fam = grains["grain"][1]
     assert fake.calls("solver", "SetFamilyPrescribedLinVel") == [(fam, "1e-05", "none", "0", False)]
     assert fake.calls("solver", "SetFamilyPrescribedAngVel") == [(fam, "0", "0", "0", False)]
-    assert fake.calls("wall", "AddPlane") == [([0.0, 0.0, 0.0], [0.0, 1.0, 0.0], "LoadMaterial")]
+    shift = adapter.wall_shift(sc, sc.walls[0])  # (test_the_engine_holds_the_scenes_overlap)
+    assert fake.calls("wall", "AddPlane") == [([0.0, shift, 0.0], [0.0, 1.0, 0.0], "LoadMaterial")]
+    assert fake.calls("wall", "SetInitPos") == [([0.0, 0.0, 0.0],)]
     assert fake.calls("solver", "SetFamilyFixed") == [(adapter.WALL_FAMILY0,)]
     assert fake.calls("solver", "SetGravitationalAcceleration") == [([0.0, -9.81, 0.0],)]
     assert fake.calls("solver", "SetIntegrator") == [("centered_difference",)]
     (_, (lo, hi), _), = fake.calls("solver", "InstructBoxDomainDimension")
     assert lo < 0.002 < hi and math.log2(hi - lo) == round(math.log2(hi - lo))  # a power of 2
+
+
+def _engine_overlap(sc, placed=True):
+    """The grain's overlap with the first wall as the engine computes it from what the adapter
+    gives it (placed) or from the scene's positions as given: the position minus the box's
+    corner in float (DEMDynamicThread, AddClumps and SetInitPos), onto the engine's grid
+    (box / 2^37), back in double; the float radius; the plane's offset from its owner and its
+    normal as float; at the start (the plate not yet turned)."""
+    f = lambda v: np.float64(np.float32(v))  # noqa: E731
+    (lo, hi) = adapter.domain(sc)[1]
+    step = (hi - lo) / 2 ** 37
+    held = lambda x: lo + np.round(f(f(x) - f(lo)) / step) * step  # noqa: E731
+    g, w = sc.grains[0], sc.walls[0]
+    n = f(adapter._xyz(w.normal))
+    if placed:
+        owner, rel = adapter.wall_placement(sc, w)
+        c = held(np.array(adapter.engine_position(sc, g)))
+        plane = held(np.array(owner)) + f(np.array(rel))
+    else:
+        c = held(adapter._xyz(g.position) - adapter.origin(sc))
+        plane = held(adapter._xyz(w.point) - adapter.origin(sc))
+    return f(g.radius) - (c - plane) @ n
+
+
+@pytest.mark.parametrize("name, off", [("drag", 0.03), ("tilt", 0.07)])
+def test_the_engine_holds_the_scenes_overlap(name, off):
+    """The paper's overlaps are 1e-5 of the radius (drag 2.67e-8 m on 2 mm), near float's
+    2^-24 of a coordinate: the grain on the positions the engine holds exactly and the wall
+    moved along its normal give the engine the scene's overlap to its grid (box / 2^38, 3.4e-5
+    of the drag's and 1.1e-5 of the tilt's overlap). Placed as given, Fn would start off by
+    3 % (drag) and 7 % (tilt), as the engine showed."""
+    sc = scene_mod.load(name)
+    g, w = sc.grains[0], sc.walls[0]
+    want = g.radius - float((adapter._xyz(g.position) - adapter._xyz(w.point)) @ adapter._xyz(w.normal))
+    (lo, hi) = adapter.domain(sc)[1]
+    assert abs(_engine_overlap(sc) - want) <= (hi - lo) / 2 ** 38
+    assert abs(_engine_overlap(sc, placed=False) - want) > off * want
+    # the grain's position and the wall's owner are exact in float, and so is each minus the corner
+    owner, _ = adapter.wall_placement(sc, w)
+    for x in adapter.engine_position(sc, g) + owner:
+        assert float(np.float32(x)) == x and float(np.float32(np.float32(x) - np.float32(lo))) == x - lo
+    assert abs(adapter.wall_shift(sc, w)) <= adapter.float_step(sc)
 
 
 def _compile_angle(code):

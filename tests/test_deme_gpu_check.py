@@ -56,23 +56,29 @@ def test_contract_rows_prescribed_as_they_are_stated():
         assert np.allclose(values, wanted[i][k - 1], rtol=0, atol=1e-12), (i, k, values, wanted[i][k - 1])
 
 
-def test_drag_bounds_pass_pyref_against_itself_and_catch_a_late_slip():
+def test_drag_bounds_pass_pyref_against_itself_and_catch_an_early_slip():
     """The drag's comparison on pyref's own run: every difference 0; the same run with the
-    saw-tooth three steps later is out of the first slip's bound."""
+    saw-tooth 12 steps earlier (as the engine gave with the grain placed as the scene states
+    it, 0.95 nm high) is out of the first slip's bound. The plane's step of overlap: float's
+    ulp of the 2 mm distance (2^-32 m) over the static overlap m g / kn."""
     from stickslip import analysis, columns
     from stickslip import scene as scene_mod
     from pyref import Simulation
 
     sc = scene_mod.load("drag")
+    g = sc.grains[0]
+    assert check.plane_quantum(sc) == pytest.approx(2.0 ** -32 / (sc.grain_mass(g) * 9.81 / sc.contact.kn), rel=1e-12)
     df = columns.frame(sc, Simulation(sc).run())
     s = analysis.summarise(sc, df)
     for key, bound in check.drag_bounds(sc).items():
         assert s[key] is not None and bound > 0
-    late = df.copy()
+    f = check.fn_spread(sc, df)  # pyref starts at its static overlap: Fn = W to 1e-3
+    assert abs(f["first"] - 1) < 1e-3 and f["min"] <= f["first"] <= f["max"] < 1 + 1e-3
+    early = df.copy()
     c = "grain-floor"
     for col in (f"{c}_fs", f"{c}_slip", f"{c}_ftx"):
-        late[col] = np.r_[np.zeros(3), late[col].to_numpy()[:-3]]
-    s2 = analysis.summarise(sc, late)
+        early[col] = np.r_[early[col].to_numpy()[12:], np.zeros(12)]
+    s2 = analysis.summarise(sc, early)
     assert abs(s2["first_slip_s"] - s["first_slip_s"]) > check.drag_bounds(sc)["first_slip_s"]
 
 
@@ -89,3 +95,65 @@ def test_summary_reads_every_part(tmp_path):
     text = check.summary(args, 300.0)
     assert "contract on the GPU: 1 of 1 rows pass" in text and "fs_fn_max" in text
     assert "bench: RuntimeError: out of memory" in text
+
+
+class _BenchSolver:
+    """A stand-in for the bench's DEMSolver: records what it is asked, steps nothing, and
+    prints its statistics with C printf in the engine's format (DEMSolver::ShowTimingStats,
+    ShowThreadCollaborationStats)."""
+
+    log = []
+
+    def __init__(self, *a):
+        self.freq = None
+
+    def __getattr__(self, name):
+        def call(*args):
+            _BenchSolver.log.append((id(self), name, args))
+            if name == "SetCDUpdateFreq":
+                self.freq = args[0]
+            return 1523200 if name == "GetNumContacts" else (float(self.freq or 37.5) if name == "GetUpdateFreq"
+                                                              else None)
+        return call
+
+    def ShowThreadCollaborationStats(self):
+        import ctypes
+        libc = ctypes.CDLL(None)
+        libc.printf(b"\n~~ kT--dT CO-OP STATISTICS ~~\nNumber of steps dynamic executed: %d\n", 20000)
+        libc.printf(b"Number of updates kinematic gets: %d\nAverage steps per dynamic update: %s\n", 400, b"50")
+
+    def ShowTimingStats(self):
+        import ctypes
+        libc = ctypes.CDLL(None)
+        libc.printf(b"\n~~ kT TIMING STATISTICS ~~\nkT total active time: %s seconds\n", b"1.5")
+        libc.printf(b"\n~~ dT TIMING STATISTICS ~~\ndT total active time: %s seconds\n", b"9.25")
+        libc.printf(b"Calculate contact forces: %s seconds, 60%% of dT total runtime\n", b"5.5")
+
+
+def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
+    """The bench, on a stand-in engine: both models alternated each round; with --cd-freq the
+    pair again with detection every N steps for both (adaptive scheduling off); the engine's
+    printed statistics read back as numbers and shown in the summary."""
+    from stickslip.adapters import deme as adapter
+
+    fake = type("FakeDeme", (), {"DEMSolver": _BenchSolver})
+    monkeypatch.setattr(adapter, "_import_deme", lambda: fake)
+    monkeypatch.setattr(adapter, "helper", lambda: type("H", (), {"attach": staticmethod(lambda *a, **k: None)}))
+    work = tmp_path / "w"
+    work.mkdir()
+    args = check.main.__globals__["argparse"].Namespace(
+        work=str(work), parts=["bench"], bench_grid=2, rounds=3, bench_steps=10, settle_steps=5, cd_freq=20,
+        t0=check.time.time(), deadline=60.0)
+    _BenchSolver.log = []
+    out = check.run_bench(args, lambda msg: None)
+    assert len(out["ratios"]) == 3 and len(out["fixed_cd"]["ratios"]) == 3
+    assert out["engine_stats"]["stock"]["Number of updates kinematic gets"] == 400
+    assert out["engine_stats"]["stickslip"]["dT: Calculate contact forces"] == 5.5
+    assert out["engine_stats"]["stock"]["kT: kT total active time"] == 1.5
+    assert out["update_freq"]["stock"] == [37.5] * 3 and out["fixed_cd"]["update_freq"]["stock"] == [20.0] * 3
+    fixed = {i for i, name, a in _BenchSolver.log if name == "DisableAdaptiveUpdateFreq"}
+    assert len(fixed) == 2 and all((i, "SetCDUpdateFreq", (20,)) in _BenchSolver.log for i in fixed)
+    (work / "bench.json").write_text(json.dumps({**out, "ok": True}, default=str))
+    text = check.summary(args, 100.0)
+    assert "contact detection: adaptive" in text and "contact detection: 20" in text
+    assert "Number of updates kinematic gets 400" in text and "dT: Calculate contact forces 5.5" in text

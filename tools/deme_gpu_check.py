@@ -266,16 +266,36 @@ def judge_row(case, trace):
 # step's load ahead (Ks V dt) and its slips may come one step apart; it reports v(t + dt/2)
 # (a dt/2 apart from pyref's v(t)); float rounds Fn, F and the threshold at 2^-24
 # relatively; positions sit on a grid of box/2^37 (deme.domain: the drag's 0.25 m box,
-# 1.8e-12 m, 7e-5 of its static overlap).
+# 1.8e-12 m, 7e-5 of its static overlap; the adapter places the grain so that its overlap
+# is the scene's, stickslip/adapters/deme.py). And the engine rounds a sphere's distance to
+# a plane to float (DEMHelperKernels.cuh, planeSignedDistance: dot(double3, float3) returns
+# float): the overlap moves in steps of ulp(r) (plane_quantum), 0.9 % of the drag's and
+# 0.3 % of the tilt's overlap, and the grain rocks between the two steps around its rest.
+def plane_quantum(sc):
+    """The engine's step of overlap on a plane, relative to the grain's static overlap:
+    ulp(dist) / overlap, dist ~ r (float: ulp(x) = 2^(floor(log2 x) - 23))."""
+    g = sc.grains[0]
+    overlap = sc.grain_mass(g) * 9.81 / sc.contact.kn
+    return 2.0 ** (math.floor(math.log2(g.radius - overlap)) - 23) / overlap
+
+
 def drag_bounds(sc):
+    """The drag's: one step's load (inc) and the grid (2e-4, with a margin of 2) as before,
+    and Fn one plane_quantum e from pyref's: |Fs|/Fn after a slip (Fmin set on the Fn of the
+    slip, read on the next) by mu_s e; the threshold mu_s Fn, so the first slip, by
+    mu_s Fn e / (Ks V); the period (2 (mu_s - mu_k) Fn / (Ks V)) by e of itself. The mean Fn
+    stays pyref's: the grain rocks about its rest."""
     p = sc.contact
     g = sc.grains[0]
     speed = float(abs(g.velocity[0]))
     fn = sc.grain_mass(g) * 9.81
     inc = p.ks * speed * sc.dt / fn  # one step's load, in |Fs|/Fn
     grid = 2e-4  # the overlap's grid (7e-5) and float, with a margin of 2
-    return {"fs_fn_max": inc + grid, "fs_fn_min": inc + grid, "fs_fn_mean": inc + grid,
-            "fn_mean_N": grid * fn, "first_slip_s": 2 * sc.dt, "slip_period_s": 2 * sc.dt,
+    e = plane_quantum(sc)
+    first = p.mu_s * fn * e / (p.ks * speed)
+    period = 2 * (p.mu_s - p.mu_k) * fn / (p.ks * speed) * e
+    return {"fs_fn_max": inc + grid, "fs_fn_min": inc + grid + p.mu_s * e, "fs_fn_mean": inc + grid + p.mu_s * e,
+            "fn_mean_N": grid * fn, "first_slip_s": 2 * sc.dt + first, "slip_period_s": 2 * sc.dt + period,
             "slip_count": 1}
 
 
@@ -308,7 +328,24 @@ def compare_case(name, args, log):
         ok = a is not None and b is not None and abs(a - b) <= bound
         rows.append({"quantity": key, "deme": a, "pyref": b, "diff": None if a is None or b is None else a - b,
                      "bound": bound, "ok": bool(ok)})
-    return {"wall_s": t_run, "notes": res.notes, "rows": rows, "deme_summary": _plain(s_d), "pyref_summary": _plain(s_p)}
+    return {"wall_s": t_run, "notes": res.notes, "rows": rows, "deme_summary": _plain(s_d), "pyref_summary": _plain(s_p),
+            "fn": {"deme": fn_spread(sc, df), "pyref": fn_spread(sc, ref)}}
+
+
+def fn_spread(sc, df):
+    """The recorded contact's Fn while it sticks before the first slip (rows 1 on): its first
+    value, least and most, each over the weight's normal share W cos(angle) (the tilt's plate
+    turns): how far the start rings."""
+    import numpy as np
+
+    c = "-".join(sc.output.contacts[0])
+    fn = df[f"{c}_fn"].to_numpy()
+    first = np.flatnonzero(df[f"{c}_slip"].to_numpy() > 0)
+    end = first[0] if len(first) else len(fn)
+    angle = df[f"{sc.output.walls[0]}_angle"].to_numpy() if sc.output.walls else np.zeros(len(fn))
+    w = sc.grain_mass(sc.grains[0]) * 9.81 * np.cos(angle)
+    rel = (fn / w)[1:end]
+    return {"first": float(rel[0]), "min": float(rel.min()), "max": float(rel.max())} if len(rel) else {}
 
 
 def tilt_bounds(sc, spread, ref):
@@ -321,16 +358,19 @@ def tilt_bounds(sc, spread, ref):
       + the float rounding of the velocity's sum over the steps after the first slip
           (2^-24 |v| a step at worst).
     The start's differences (the engine's first step loads the spring) end at the first slip,
-    which resets the spring (eq. 8)."""
+    which resets the spring (eq. 8). And Fn one plane_quantum e from pyref's: the slip,
+    at tan(beta) = mu_s (1 +- e), by mu_s e in tan(beta) and mu_s e / rate in time (d tan/dt
+    >= the plate's rate)."""
     dt, every = sc.dt, sc.output.every
     w = sc.walls[0]
     tan_rate = sc.rotation_rate(w) / math.cos(w.rotation.stop_angle) ** 2  # d tan(beta)/dt at most, 1/s
+    e = sc.contact.mu_s * plane_quantum(sc)
     v_spread = spread.get("final_speed_spread", math.nan) if spread else math.nan
     t1, v1 = ref.get("t_first_slip_s") or 0.0, abs(ref.get("final_speed_mps") or 0.0)
     sliding = (sc.duration - t1) / dt * 2 ** -24 * v1
     speed = (3 * v_spread if math.isfinite(v_spread) else 0.0) + 9.81 * dt / 2 + sliding
-    return {"t_first_slip_s": every * dt + 1e-12, "tan_beta_first_slip": every * dt * tan_rate + 1e-9,
-            "final_speed_mps": speed}
+    return {"t_first_slip_s": every * dt + e / sc.rotation_rate(w) + 1e-12,
+            "tan_beta_first_slip": every * dt * tan_rate + e + 1e-9, "final_speed_mps": speed}
 
 
 def run_spread(args, log):
@@ -374,9 +414,11 @@ def bed(grid):
     return r, span, pts
 
 
-def bench_solver(deme, kind, grid, dt):
+def bench_solver(deme, kind, grid, dt, cd_freq=0):
     """One solver of the bench: kind "stickslip" (the force model, Hertz-Mindlin normal force,
-    mu 0.5, mu_k 0.45) or "stock" (the engine's frictional Hertz-Mindlin, mu 0.5)."""
+    mu 0.5, mu_k 0.45) or "stock" (the engine's frictional Hertz-Mindlin, mu 0.5). cd_freq 0:
+    the engine's own scheduling of contact detection (adaptive); N > 0: detection every N
+    steps for both (DisableAdaptiveUpdateFreq), which leaves the force model's cost alone."""
     from stickslip.adapters import deme as adapter
 
     ss = adapter.helper()
@@ -398,6 +440,9 @@ def bench_solver(deme, kind, grid, dt):
     solver.SetGravitationalAcceleration([0.0, 0.0, -9.81])
     solver.SetTimeStepSize(dt)
     solver.SetMaxVelocity(2.0)
+    if cd_freq > 0:
+        solver.SetCDUpdateFreq(cd_freq)
+        solver.DisableAdaptiveUpdateFreq()
     return solver, len(pts)
 
 
@@ -413,36 +458,80 @@ def run_warm_stock(args, log):
     return {"init_s": time.perf_counter() - t0}
 
 
-def run_bench(args, log):
-    import statistics
-    from stickslip.adapters import deme as adapter
+def printed(call):
+    """What a call of the engine prints (C printf, on file descriptor 1), as text."""
+    import ctypes
+    import tempfile
 
-    deme = adapter._import_deme()
+    sys.stdout.flush()
+    libc = ctypes.CDLL(None)
+    with tempfile.TemporaryFile(mode="w+") as tmp:
+        saved = os.dup(1)
+        os.dup2(tmp.fileno(), 1)
+        try:
+            call()
+        finally:
+            libc.fflush(None)
+            os.dup2(saved, 1)
+            os.close(saved)
+        tmp.seek(0)
+        return tmp.read()
+
+
+def engine_stats(text):
+    """The engine's own statistics (ShowThreadCollaborationStats, ShowTimingStats) as numbers:
+    {"Number of updates kinematic gets": 40.0, ..., "dT: Calculate contact forces": 1.2, ...}
+    (timers in seconds, each thread's under its prefix)."""
+    import re
+
+    stats, thread = {}, ""
+    for line in text.splitlines():
+        if "kT TIMING" in line:
+            thread = "kT: "
+        elif "dT TIMING" in line:
+            thread = "dT: "
+        m = re.match(r"\s*([^:~]+):\s*([-+0-9.eE]+)", line)
+        if m:
+            stats[thread + m.group(1).strip()] = float(m.group(2))
+    return stats
+
+
+def _bench_pair(args, deme, log, cd_freq, wait):
+    """The two models on the same bed: initialise, settle, then `rounds` blocks of each,
+    alternated; block times, contacts, the engine's update frequency after each block and its
+    own statistics over the rounds."""
+    from stickslip.adapters import deme as adapter
+    from stickslip.bench.ratio_interval import ratio_interval
+    import statistics
+
     dt, steps = 2e-6, args.bench_steps
-    out = {"spheres": args.bench_grid ** 3, "dt": dt, "steps_per_block": steps, "settle_steps": args.settle_steps}
-    ss_solver, n = bench_solver(deme, "stickslip", args.bench_grid, dt)
+    out = {"spheres": args.bench_grid ** 3, "dt": dt, "steps_per_block": steps, "settle_steps": args.settle_steps,
+           "cd_freq": cd_freq or "adaptive"}
+    ss_solver, n = bench_solver(deme, "stickslip", args.bench_grid, dt, cd_freq)
     t0 = time.perf_counter()
     ss_solver.Initialize()
     out["init_stickslip_s"] = time.perf_counter() - t0
-    log(f"bench: stick-slip initialised in {out['init_stickslip_s']:.0f} s")
+    log(f"bench ({out['cd_freq']}): stick-slip initialised in {out['init_stickslip_s']:.0f} s")
     # (the stock model's compile, warm_stock, runs beside this one's: wait for it, but leave
     # time for a cold compile here and the rounds)
     if "warm_stock" in args.parts:
         wait_json(Path(args.work) / "warm_stock.json", args.t0 + args.deadline - 200 - time.time())
     out["stock_cache_warmed"] = (Path(args.work) / "warm_stock.json").is_file()
-    stock, _ = bench_solver(deme, "stock", args.bench_grid, dt)
+    stock, _ = bench_solver(deme, "stock", args.bench_grid, dt, cd_freq)
     t0 = time.perf_counter()
     stock.Initialize()
     out["init_stock_s"] = time.perf_counter() - t0
-    log(f"bench: stock initialised in {out['init_stock_s']:.0f} s")
+    log(f"bench ({out['cd_freq']}): stock initialised in {out['init_stock_s']:.0f} s")
     solvers = {"stickslip": ss_solver, "stock": stock}
     for name, s in solvers.items():  # settle (the bed falls the 1 % gaps and starts its contacts)
         s.DoDynamicsThenSync(adapter.steps_duration(args.settle_steps, dt))
-    alone = wait_parts(args, [p for p in GPU_PARTS if p in args.parts],
-                       args.t0 + args.deadline - 30 - 8 * args.rounds - time.time())
-    out["gpu_to_itself"] = alone
+    out["gpu_to_itself"] = wait()
+    for s in solvers.values():
+        s.ClearTimingStats()
+        s.ClearThreadCollaborationStats()
     times = {"stickslip": [], "stock": []}
     contacts = {"stickslip": [], "stock": []}
+    freq = {"stickslip": [], "stock": []}
     for rnd in range(args.rounds):
         order = ("stickslip", "stock") if rnd % 2 == 0 else ("stock", "stickslip")
         for name in order:
@@ -450,20 +539,39 @@ def run_bench(args, log):
             t0 = time.perf_counter()
             s.DoDynamicsThenSync(adapter.steps_duration(steps, dt))
             times[name].append(time.perf_counter() - t0)
-            try:
-                contacts[name].append(int(s.GetNumContacts()))
-            except Exception:
-                contacts[name].append(None)
-        log(f"bench: round {rnd + 1}: stick-slip {times['stickslip'][-1]:.3f} s, stock {times['stock'][-1]:.3f} s")
+            contacts[name].append(int(s.GetNumContacts()))
+            freq[name].append(float(s.GetUpdateFreq()))
+        log(f"bench ({out['cd_freq']}): round {rnd + 1}: stick-slip {times['stickslip'][-1]:.3f} s, "
+            f"stock {times['stock'][-1]:.3f} s")
+    out["engine_stats"], out["engine_text"] = {}, {}
+    for name, s in solvers.items():
+        text = printed(lambda: (s.ShowThreadCollaborationStats(), s.ShowTimingStats()))
+        out["engine_text"][name], out["engine_stats"][name] = text, engine_stats(text)
     ratios = [a / b for a, b in zip(times["stickslip"], times["stock"])]
     # the geometric mean of the rounds' ratios and its 95 % interval over rounds (the CPU
     # engines' benchmarks do the same: stickslip/bench/ratio_interval.py)
-    from stickslip.bench.ratio_interval import ratio_interval
     out["ratio_geomean"], out["ratio_low"], out["ratio_high"] = ratio_interval(
         list(zip(times["stock"], times["stickslip"])))
-    out.update(times=times, contacts=contacts, ratios=ratios, ratio_mean=statistics.mean(ratios),
+    out.update(times=times, contacts=contacts, update_freq=freq, ratios=ratios, ratio_mean=statistics.mean(ratios),
                ratio_min=min(ratios), ratio_max=max(ratios),
                ms_per_step={k: [1e3 * t / steps for t in v] for k, v in times.items()})
+    return out
+
+
+def run_bench(args, log):
+    """The bench with the engine's scheduling of contact detection, then (--cd-freq N) with
+    detection every N steps for both models, one pair of solvers after the other."""
+    import gc
+    from stickslip.adapters import deme as adapter
+
+    deme = adapter._import_deme()
+    others = [p for p in GPU_PARTS if p in args.parts]
+    out = _bench_pair(args, deme, log, 0, lambda: wait_parts(
+        args, others, args.t0 + args.deadline - 30 - 8 * args.rounds * (2 if args.cd_freq else 1) - time.time()))
+    (Path(args.work) / "bench_adaptive.json").write_text(json.dumps(out, default=str))  # (kept if the next part stops)
+    if args.cd_freq > 0:
+        gc.collect()
+        out["fixed_cd"] = _bench_pair(args, deme, log, args.cd_freq, lambda: wait_parts(args, others, 0))
     return out
 
 
@@ -482,13 +590,15 @@ def wait_json(path, timeout):
 
 
 def wait_parts(args, parts, timeout):
-    """True once every part of `parts` has ended (its .done marker), False at the timeout."""
+    """True once every part of `parts` has ended (its .done marker), False at the timeout
+    (looked at once at least)."""
     end = time.time() + timeout
-    while time.time() < end:
+    while True:
         if all((Path(args.work) / f"{p}.done").exists() for p in parts):
             return True
+        if time.time() >= end:
+            return False
         time.sleep(1.0)
-    return False
 
 
 def _plain(d):
@@ -533,7 +643,7 @@ def orchestrate(args):
         cmd = [sys.executable, __file__, "--part", part, "--work", str(out), "--deadline", str(args.deadline),
                "--bench-grid", str(args.bench_grid), "--rounds", str(args.rounds), "--t0", repr(t_start),
                "--tilt-every", str(args.tilt_every), "--bench-steps", str(args.bench_steps),
-               "--settle-steps", str(args.settle_steps), "--parts", *args.parts]
+               "--settle-steps", str(args.settle_steps), "--cd-freq", str(args.cd_freq), "--parts", *args.parts]
         procs[part] = (subprocess.Popen(cmd, stdout=logf, stderr=subprocess.STDOUT, env=env), logf)
         print(f"started {part}", flush=True)
     pending = set(procs)
@@ -592,6 +702,10 @@ def summary(args, elapsed):
             for r in d["rows"]:
                 lines.append(f"  {r['quantity']:22s} deme {r['deme']!s:>22.22} pyref {r['pyref']!s:>22.22} "
                              f"diff {r['diff']!s:>11.11} bound {r['bound']:.3g} {'ok' if r['ok'] else 'OUT'}")
+            for who, f in (d.get("fn") or {}).items():
+                if f:
+                    lines.append(f"  Fn / (W cos angle) before the first slip, {who}: first {f['first']:.6f}, "
+                                 f"min {f['min']:.6f}, max {f['max']:.6f}")
         elif name in res:
             lines.append(f"{name}: {'no result' if not d else d.get('error')}")
     s = res.get("spread")
@@ -600,23 +714,42 @@ def summary(args, elapsed):
                      f"(final speeds {', '.join(f'{v:.6f}' for v in s['final_speeds'])})")
     b = res.get("bench")
     if b and b.get("ok"):
-        lines.append(f"bench: {b['spheres']} spheres, {b['steps_per_block']} steps a block, dt {b['dt']:g}; "
-                     f"initialise stick-slip {b['init_stickslip_s']:.0f} s, stock {b['init_stock_s']:.0f} s "
-                     f"(cache warmed by the other process: {b['stock_cache_warmed']}); GPU to itself: "
-                     f"{b['gpu_to_itself']}")
-        lines.append(f"  ms per step: stick-slip {', '.join(f'{v:.3f}' for v in b['ms_per_step']['stickslip'])}; "
-                     f"stock {', '.join(f'{v:.3f}' for v in b['ms_per_step']['stock'])}")
-        lines.append(f"  contacts: stick-slip {b['contacts']['stickslip']}, stock {b['contacts']['stock']}")
-        lines.append(f"  stick-slip / stock per round: {', '.join(f'{r:.3f}' for r in b['ratios'])}; mean "
-                     f"{b['ratio_mean']:.3f}, range {b['ratio_min']:.3f}-{b['ratio_max']:.3f}; geometric mean "
-                     f"{b['ratio_geomean']:.3f} (95 % over rounds {b['ratio_low']:.3f}-{b['ratio_high']:.3f}; "
-                     f"target <= 1.05)")
+        lines += bench_lines(b)
+        if b.get("fixed_cd"):
+            lines += bench_lines(b["fixed_cd"])
     elif "bench" in res:
         lines.append(f"bench: {'no result' if not b else b.get('error')}")
     w = res.get("warm_stock")
     if w and not w.get("ok"):
         lines.append(f"warm_stock: {w.get('error')}")
     return "\n".join(lines) + "\n"
+
+
+STATS_SHOWN = ("Number of updates kinematic gets", "Average steps per dynamic update",
+               "Number of times dynamic held back", "kT total active time", "dT total active time",
+               "dT: Calculate contact forces", "dT: Wait for kT update", "dT: Integration")
+
+
+def bench_lines(b):
+    """The summary's lines for one pair of bench solvers."""
+    lines = [f"bench (contact detection: {b.get('cd_freq', 'adaptive')}): {b['spheres']} spheres, "
+             f"{b['steps_per_block']} steps a block, dt {b['dt']:g}; initialise stick-slip "
+             f"{b['init_stickslip_s']:.0f} s, stock {b['init_stock_s']:.0f} s (cache warmed by the other "
+             f"process: {b['stock_cache_warmed']}); GPU to itself: {b['gpu_to_itself']}",
+             f"  ms per step: stick-slip {', '.join(f'{v:.3f}' for v in b['ms_per_step']['stickslip'])}; "
+             f"stock {', '.join(f'{v:.3f}' for v in b['ms_per_step']['stock'])}",
+             f"  contacts: stick-slip {b['contacts']['stickslip']}, stock {b['contacts']['stock']}"]
+    if b.get("update_freq"):
+        lines.append(f"  engine's update frequency after each block: stick-slip {b['update_freq']['stickslip']}, "
+                     f"stock {b['update_freq']['stock']}")
+    for name, st in (b.get("engine_stats") or {}).items():
+        shown = [f"{k} {st[k]:.4g}" for k in STATS_SHOWN if k in st]
+        lines.append(f"  engine's own statistics over the rounds, {name}: " + ("; ".join(shown) or "none printed"))
+    lines.append(f"  stick-slip / stock per round: {', '.join(f'{r:.3f}' for r in b['ratios'])}; mean "
+                 f"{b['ratio_mean']:.3f}, range {b['ratio_min']:.3f}-{b['ratio_max']:.3f}; geometric mean "
+                 f"{b['ratio_geomean']:.3f} (95 % over rounds {b['ratio_low']:.3f}-{b['ratio_high']:.3f}; "
+                 f"target <= 1.05)")
+    return lines
 
 
 def main(argv=None):
@@ -635,6 +768,8 @@ def main(argv=None):
     ap.add_argument("--settle-steps", type=int, default=2000,
                     help="steps each bench solver runs before the rounds (default 2000)")
     ap.add_argument("--tilt-every", type=int, default=25, help="the tilt's rows, in steps (default 25)")
+    ap.add_argument("--cd-freq", type=int, default=0,
+                    help="N > 0: the bench again with contact detection every N steps for both models")
     args = ap.parse_args(argv)
     Path(args.work).mkdir(parents=True, exist_ok=True)
     if args.t0 is None:

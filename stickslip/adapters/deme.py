@@ -10,6 +10,13 @@ prescribed zero spin, imposed velocity components as prescribed ones. Walls are 
 planes: fixed, or turned about their pivot with the angle of each step prescribed (pyref's,
 Scene.rotation_steps and rotation_rate) and its rate as the plane's spin.
 
+The engine takes positions and radii as float and subtracts its box's corner from a position
+in float. Its frame is centred on the first wall's pivot (origin); grains sit on the
+positions it holds exactly (float_step: 2^-23 of the box's half edge); and each wall is moved
+along its normal by a few nanometres at most (wall_shift) so that the grain nearest to it has
+the scene's overlap with its float radius. The paper's overlaps are 1e-5 of a radius: placed
+as given, Fn would start 3 % low in the drag and 7 % high in the tilt, and ring.
+
 What differs from the CPU engines (deme_model/README.md): float arithmetic, positions kept
 on the engine's grid (its box / 2^37 per axis), the first step loads the spring (no set-up
 evaluation: row 0 has zero contact forces, as LIGGGHTS'), the velocity reported is the
@@ -101,15 +108,78 @@ def _expr(x):
     return repr(float(x))
 
 
+def _xyz(v):
+    """A scene vector (2 or 3 components) as 3 floats."""
+    v = [float(c) for c in v]
+    return np.array(v + [0.0] * (3 - len(v)))
+
+
+def origin(scene):
+    """The scene point at the engine's origin, the centre of its box: the first wall's pivot
+    (its point if it does not turn), else the first grain's centre."""
+    if scene.walls:
+        w = scene.walls[0]
+        return _xyz(w.rotation.pivot if w.rotation is not None else w.point)
+    return _xyz(scene.grains[0].position)
+
+
 def domain(scene):
-    """A cube around the grains, its edge a power of 2 (grid positions then exact binary
-    fractions) at least 4x the grains' extent and reach: (lo, hi) per axis."""
-    pos = np.array([g.position for g in scene.grains])
+    """A cube centred on the engine's origin, in engine coordinates (scene minus origin), its
+    edge a power of 2 at least 4x the grains' distance from the origin and reach: its corner,
+    which the engine keeps as float, is then exact, and grid positions are exact binary
+    fractions. (lo, hi) per axis."""
+    o = origin(scene)
+    dist = max(float(np.max(np.abs(_xyz(g.position) - o))) for g in scene.grains)
     reach = max(float(np.linalg.norm(g.velocity)) * scene.duration + 10 * g.radius for g in scene.grains)
-    centre = 0.5 * (pos.min(axis=0) + pos.max(axis=0))
-    half = 4 * (float(np.max(pos.max(axis=0) - pos.min(axis=0))) / 2 + reach)
-    half = 2.0 ** math.ceil(math.log2(max(half, 1e-3)))
-    return [(float(c - half), float(c + half)) for c in centre]
+    half = 2.0 ** math.ceil(math.log2(max(4 * (dist + reach), 1e-3)))
+    return [(-half, half)] * 3
+
+
+def float_step(scene):
+    """The spacing of the positions the engine takes exactly: AddClumps, SetInitPos and a
+    tracker's SetPos subtract the box's corner in float (position - corner, both float), so a
+    position is held exactly only on multiples of 2^-23 of the box's half edge (the drag's:
+    1.5e-8 m, half its static overlap); elsewhere it moves by up to half of that."""
+    return domain(scene)[0][1] * 2.0 ** -23
+
+
+def _snap(scene, x):
+    step = float_step(scene)
+    return np.round(np.asarray(x, float) / step) * step
+
+
+def engine_position(scene, g):
+    """A grain's centre in engine coordinates, on the float_step grid (where the engine holds
+    it exactly): within float_step/2 of the scene's, a difference wall_shift takes up."""
+    return [float(v) for v in _snap(scene, _xyz(g.position) - origin(scene))]
+
+
+def wall_shift(scene, w):
+    """How far along its normal the engine's plane is moved from the scene's so that the grain
+    nearest to it has the scene's overlap with the engine's float radius and its centre on the
+    grid: the paper's overlaps are 1e-5 of a radius, close to float's 2^-24 of one, and the
+    rounded radius and centre would change Fn by up to 3 % (drag) and 7 % (tilt) and set
+    the grain ringing. s = (r - float(r)) + (c_engine - c) . n, c in engine coordinates. (The
+    centre's move along the wall stays: a few nm, which the grain settles from at once.)"""
+    n = _xyz(w.normal) / np.linalg.norm(_xyz(w.normal))
+    o, p = origin(scene), _xyz(w.point)
+    g = min(scene.grains, key=lambda g: abs(float((_xyz(g.position) - p) @ n) - g.radius))
+    c = _xyz(g.position) - o
+    return (g.radius - float(np.float32(g.radius))) + float((np.array(engine_position(scene, g)) - c) @ n)
+
+
+def wall_placement(scene, w):
+    """A wall's owner (engine coordinates, on the float_step grid) and its plane's point
+    relative to the owner: the pivot's remainder from the grid, the plane's offset from its
+    pivot and wall_shift along the normal (float, small: exact to ~1e-15 m). The first wall's
+    pivot is the origin, on the grid: it turns about its pivot exactly; another turning wall
+    would turn about a point up to float_step/2 from its pivot."""
+    n = _xyz(w.normal) / np.linalg.norm(_xyz(w.normal))
+    pivot = _xyz(w.rotation.pivot) if w.rotation is not None else _xyz(w.point)
+    pivot_e = pivot - origin(scene)
+    owner = _snap(scene, pivot_e)
+    rel = (pivot_e - owner) + (_xyz(w.point) - pivot) + wall_shift(scene, w) * n
+    return [float(v) for v in owner], [float(v) for v in rel]
 
 
 def turning_prescription(scene, w):
@@ -166,8 +236,8 @@ def build(scene, deme):
     for k, g in enumerate(scene.grains):
         fam = GRAIN_FAMILY0 + k
         template = solver.LoadSphereType(scene.grain_mass(g), g.radius, mat)
-        batch = solver.AddClumps(template, [[float(v) for v in g.position[:3]]])
-        batch.SetVel([[float(v) for v in g.velocity[:3]]])
+        batch = solver.AddClumps(template, [engine_position(scene, g)])
+        batch.SetVel([[float(v) for v in _xyz(g.velocity)]])
         batch.SetFamily(fam)
         if g.fixed:
             solver.SetFamilyFixed(fam)
@@ -183,16 +253,16 @@ def build(scene, deme):
     for k, w in enumerate(scene.walls):
         fam = WALL_FAMILY0 + k
         obj = solver.AddExternalObject()
-        pivot = w.rotation.pivot if w.rotation is not None else np.zeros(3)
-        obj.AddPlane([float(v) for v in (w.point - pivot)[:3]], [float(v) for v in w.normal[:3]], mat)
-        obj.SetInitPos([float(v) for v in pivot[:3]])
+        owner, rel = wall_placement(scene, w)
+        obj.AddPlane(rel, [float(v) for v in _xyz(w.normal)], mat)
+        obj.SetInitPos(owner)
         obj.SetMass(1.0)
         obj.SetFamily(fam)
         if w.rotation is None:
             solver.SetFamilyFixed(fam)
         else:
             quat, spin = turning_prescription(scene, w)
-            solver.SetFamilyPrescribedPosition(fam, *[_expr(v) for v in pivot[:3]])
+            solver.SetFamilyPrescribedPosition(fam, *[_expr(v) for v in owner])
             solver.SetFamilyPrescribedQuaternion(fam, quat)
             solver.SetFamilyPrescribedAngVel(fam, *spin)
     solver.SetTimeStepSize(scene.dt)
@@ -218,6 +288,7 @@ def run(scene, out_dir, progress=None):
     t0 = time.perf_counter()
     solver, grains = build(scene, deme)
     solver.Initialize()  # (compiles the kernels: minutes on a cold cache, deme_model/README.md)
+    o = origin(scene)[:scene.dimension]
     t_init = time.perf_counter() - t0
     out, d, dt, every = scene.output, scene.dimension, scene.dt, scene.output.every
     rows = scene.steps // every
@@ -236,7 +307,7 @@ def run(scene, out_dir, progress=None):
     def sample(r, step):
         for i, name in enumerate(out.grains):
             tracker, _ = grains[name]
-            x[r, i] = np.asarray(tracker.Pos(), float)[:d]
+            x[r, i] = np.asarray(tracker.Pos(), float)[:d] + o  # (engine frame to the scene's)
             v[r, i] = np.asarray(tracker.Vel(), float)[:d]
         for i, (a, _) in enumerate(out.contacts):
             if r == 0:
