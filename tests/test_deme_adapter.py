@@ -209,14 +209,14 @@ def _engine_overlap(sc, placed=True):
     step = (hi - lo) / 2 ** 37
     held = lambda x: lo + np.round(f(f(x) - f(lo)) / step) * step  # noqa: E731
     g, w = sc.grains[0], sc.walls[0]
-    n = f(adapter._xyz(w.normal))
+    n = f(w.normal)
     if placed:
         owner, rel = adapter.wall_placement(sc, w)
         c = held(np.array(adapter.engine_position(sc, g)))
         plane = held(np.array(owner)) + f(np.array(rel))
     else:
-        c = held(adapter._xyz(g.position) - adapter.origin(sc))
-        plane = held(adapter._xyz(w.point) - adapter.origin(sc))
+        c = held(g.position - adapter.origin(sc))
+        plane = held(w.point - adapter.origin(sc))
     return f(g.radius) - (c - plane) @ n
 
 
@@ -229,7 +229,7 @@ def test_the_engine_holds_the_scenes_overlap(name, off):
     3 % (drag) and 7 % (tilt), as the engine showed."""
     sc = scene_mod.load(name)
     g, w = sc.grains[0], sc.walls[0]
-    want = g.radius - float((adapter._xyz(g.position) - adapter._xyz(w.point)) @ adapter._xyz(w.normal))
+    want = g.radius - float((g.position - w.point) @ w.normal)
     (lo, hi) = adapter.domain(sc)[1]
     assert abs(_engine_overlap(sc) - want) <= (hi - lo) / 2 ** 38
     assert abs(_engine_overlap(sc, placed=False) - want) > off * want

@@ -108,10 +108,13 @@ def _expr(x):
     return repr(float(x))
 
 
-def _xyz(v):
-    """A scene vector (2 or 3 components) as 3 floats."""
-    v = [float(c) for c in v]
-    return np.array(v + [0.0] * (3 - len(v)))
+def _pivot(w):
+    """The point a wall turns about: its pivot, or its own point if it does not turn."""
+    return w.rotation.pivot if w.rotation is not None else w.point
+
+
+def _unit_normal(w):
+    return w.normal / np.linalg.norm(w.normal)
 
 
 def origin(scene):
@@ -119,8 +122,8 @@ def origin(scene):
     (its point if it does not turn), else the first grain's centre."""
     if scene.walls:
         w = scene.walls[0]
-        return _xyz(w.rotation.pivot if w.rotation is not None else w.point)
-    return _xyz(scene.grains[0].position)
+        return np.array(_pivot(w))
+    return np.array(scene.grains[0].position)
 
 
 def domain(scene):
@@ -129,7 +132,7 @@ def domain(scene):
     which the engine keeps as float, is then exact, and grid positions are exact binary
     fractions. (lo, hi) per axis."""
     o = origin(scene)
-    dist = max(float(np.max(np.abs(_xyz(g.position) - o))) for g in scene.grains)
+    dist = max(float(np.max(np.abs(g.position - o))) for g in scene.grains)
     reach = max(float(np.linalg.norm(g.velocity)) * scene.duration + 10 * g.radius for g in scene.grains)
     half = 2.0 ** math.ceil(math.log2(max(4 * (dist + reach), 1e-3)))
     return [(-half, half)] * 3
@@ -151,7 +154,7 @@ def _snap(scene, x):
 def engine_position(scene, g):
     """A grain's centre in engine coordinates, on the float_step grid (where the engine holds
     it exactly): within float_step/2 of the scene's, a difference wall_shift takes up."""
-    return [float(v) for v in _snap(scene, _xyz(g.position) - origin(scene))]
+    return [float(v) for v in _snap(scene, g.position - origin(scene))]
 
 
 def wall_shift(scene, w):
@@ -162,10 +165,10 @@ def wall_shift(scene, w):
     float radius 0.1 nm larger), up to 28 % for a centre half a float_step away, and the
     grain would ring. s = (r - float(r)) + (c_engine - c) . n, c in engine coordinates. (The
     centre's move along the wall stays: a few nm, which changes no force on a plane.)"""
-    n = _xyz(w.normal) / np.linalg.norm(_xyz(w.normal))
-    o, p = origin(scene), _xyz(w.point)
-    g = min(scene.grains, key=lambda g: abs(float((_xyz(g.position) - p) @ n) - g.radius))
-    c = _xyz(g.position) - o
+    n = _unit_normal(w)
+    o, p = origin(scene), w.point
+    g = min(scene.grains, key=lambda g: abs(float((g.position - p) @ n) - g.radius))
+    c = g.position - o
     return (g.radius - float(np.float32(g.radius))) + float((np.array(engine_position(scene, g)) - c) @ n)
 
 
@@ -175,11 +178,11 @@ def wall_placement(scene, w):
     pivot and wall_shift along the normal (float, small: exact to ~1e-15 m). The first wall's
     pivot is the origin, on the grid: it turns about its pivot exactly; another turning wall
     would turn about a point up to float_step/2 from its pivot."""
-    n = _xyz(w.normal) / np.linalg.norm(_xyz(w.normal))
-    pivot = _xyz(w.rotation.pivot) if w.rotation is not None else _xyz(w.point)
+    n = _unit_normal(w)
+    pivot = _pivot(w)
     pivot_e = pivot - origin(scene)
     owner = _snap(scene, pivot_e)
-    rel = (pivot_e - owner) + (_xyz(w.point) - pivot) + wall_shift(scene, w) * n
+    rel = (pivot_e - owner) + (w.point - pivot) + wall_shift(scene, w) * n
     return [float(v) for v in owner], [float(v) for v in rel]
 
 
@@ -238,7 +241,7 @@ def build(scene, deme):
         fam = GRAIN_FAMILY0 + k
         template = solver.LoadSphereType(scene.grain_mass(g), g.radius, mat)
         batch = solver.AddClumps(template, [engine_position(scene, g)])
-        batch.SetVel([[float(v) for v in _xyz(g.velocity)]])
+        batch.SetVel([[float(v) for v in g.velocity]])
         batch.SetFamily(fam)
         if g.fixed:
             solver.SetFamilyFixed(fam)
@@ -255,7 +258,7 @@ def build(scene, deme):
         fam = WALL_FAMILY0 + k
         obj = solver.AddExternalObject()
         owner, rel = wall_placement(scene, w)
-        obj.AddPlane(rel, [float(v) for v in _xyz(w.normal)], mat)
+        obj.AddPlane(rel, [float(v) for v in w.normal], mat)
         obj.SetInitPos(owner)
         obj.SetMass(1.0)
         obj.SetFamily(fam)
