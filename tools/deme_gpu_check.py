@@ -568,7 +568,6 @@ def run_bench(args, log):
     others = [p for p in GPU_PARTS if p in args.parts]
     out = _bench_pair(args, deme, log, 0, lambda: wait_parts(
         args, others, args.t0 + args.deadline - 30 - 8 * args.rounds * (2 if args.cd_freq else 1) - time.time()))
-    (Path(args.work) / "bench_adaptive.json").write_text(json.dumps(out, default=str))  # (kept if the next part stops)
     if args.cd_freq > 0:
         gc.collect()
         out["fixed_cd"] = _bench_pair(args, deme, log, args.cd_freq, lambda: wait_parts(args, others, 0))

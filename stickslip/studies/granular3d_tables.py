@@ -442,8 +442,7 @@ def summary(t, figs):
                                         "se_fixed", "weinhart_at_fixed_depth", "difference_fixed", "z_fixed",
                                         "within_0.7_fixed", "fixed_lag", "fixed_lag_se"]
                   if "theta_stop_fixed" in t["validation.csv"] else ["engine"]),
-              _md(t.get("holds.csv"), ["engine", "layers", "fill", "angles", "highest_stopped", "lowest_flowing", "ordered",
-                                       "theta_stop", "depth_d", "longest_stop", "flowing_least_trend"]),
+              _md(t.get("holds.csv"), HOLD_COLUMNS),
               "## Checks of the set-up", "",
               _md(t["checks.csv"], ["check", "angle", "reference", "checked", "difference", "z"]),
               "## Predictions", "",
