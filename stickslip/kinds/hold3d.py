@@ -65,16 +65,7 @@ def claims(scene):
 
 def figures(out, runs):
     """Mean speed along the slope against time, one figure per run."""
-    from ..plotstyle import pyplot, save
-
-    plt, names = pyplot(), []
-    for key, (scene, summary, df) in runs.items():
-        fig, ax = plt.subplots(figsize=(6, 3.5))
-        ax.semilogy(df["t"], np.maximum(np.abs(incline3d.downhill_speed(scene, df)), 1e-7), lw=0.6)
-        ax.set_xlabel("time")
-        ax.set_ylabel("mean speed along the slope")
-        names.append(save(fig, out, f"hold3d_{'_'.join(str(k) for k in key)}.png"))
-    return names
+    return incline3d.speed_figures(out, runs, NAME, lambda df: df["t"], "time")
 
 
 def precision_figures(out, runs):

@@ -91,19 +91,28 @@ def claims(scene):
 
 
 def figures(out, runs):
-    """Mean speed along the slope against the angle, one figure per run."""
+    """Mean speed along the slope against the angle, one figure per run, theta_stop and
+    theta_start marked."""
+    def marks(summary):
+        return [summary[f"theta_{k}_deg"] for k in ("stop", "start")
+                if np.isfinite(summary.get(f"theta_{k}_deg", math.nan))]
+    return speed_figures(out, runs, NAME, lambda df: np.degrees(df["tilt"]), "tilt (deg)", marks)
+
+
+def speed_figures(out, runs, prefix, x, xlabel, marks=lambda summary: ()):
+    """The bed's mean speed along the slope (log scale) against x(df), one figure per run
+    (prefix_KEY.png), a dashed line at each of marks(summary); for this kind and hold3d."""
     from ..plotstyle import pyplot, save
 
     plt, names = pyplot(), []
     for key, (scene, summary, df) in runs.items():
         fig, ax = plt.subplots(figsize=(6, 3.5))
-        ax.semilogy(np.degrees(df["tilt"]), np.maximum(np.abs(downhill_speed(scene, df)), 1e-7), lw=0.6)
-        for k in ("stop", "start"):
-            if np.isfinite(summary.get(f"theta_{k}_deg", math.nan)):
-                ax.axvline(summary[f"theta_{k}_deg"], ls="--", color="0.4")
-        ax.set_xlabel("tilt (deg)")
+        ax.semilogy(x(df), np.maximum(np.abs(downhill_speed(scene, df)), 1e-7), lw=0.6)
+        for m in marks(summary):
+            ax.axvline(m, ls="--", color="0.4")
+        ax.set_xlabel(xlabel)
         ax.set_ylabel("mean speed along the slope")
-        names.append(save(fig, out, f"incline3d_{'_'.join(str(k) for k in key)}.png"))
+        names.append(save(fig, out, f"{prefix}_{'_'.join(str(k) for k in key)}.png"))
     return names
 
 
