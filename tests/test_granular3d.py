@@ -518,3 +518,14 @@ def test_the_pages_calibrate_examples_print_what_the_page_shows(capsys):
         code = main(command.split())
         got = capsys.readouterr()
         assert (got.out if code == 0 else got.err).strip() == shown.strip(), command
+
+
+def test_the_tables_scene_layers_are_the_scenes():
+    """granular3d_tables.SCENE_LAYERS names the 10 d bed that runs.csv writes as layers 0: it
+    is cases/incline3d.toml's lattice height, and the held beds' keys use it."""
+    from stickslip.studies import granular3d, granular3d_tables
+
+    base = tomllib.loads(scene_mod.find("incline3d").read_text())
+    assert granular3d_tables.SCENE_LAYERS == base["lattice"][0]["counts"][2]
+    assert granular3d_tables.bed_layers(0) == granular3d_tables.SCENE_LAYERS and granular3d_tables.bed_layers(36.0) == 36
+    assert set(granular3d.HOLD_ANGLES) == {granular3d_tables.SCENE_LAYERS, granular3d.DEEP_LAYERS}

@@ -328,7 +328,8 @@ def compare_case(name, args, log):
         ok = a is not None and b is not None and abs(a - b) <= bound
         rows.append({"quantity": key, "deme": a, "pyref": b, "diff": None if a is None or b is None else a - b,
                      "bound": bound, "ok": bool(ok)})
-    return {"wall_s": t_run, "notes": res.notes, "rows": rows, "deme_summary": _plain(s_d), "pyref_summary": _plain(s_p),
+    return {"wall_s": t_run, "notes": res.notes, "rows": rows, "deme_summary": _plain(s_d),
+            "pyref_summary": _plain(s_p),
             "fn": {"deme": fn_spread(sc, df), "pyref": fn_spread(sc, ref)}}
 
 

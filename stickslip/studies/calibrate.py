@@ -52,9 +52,10 @@ def load_map(path, rolling, nu_s="paper"):
     val = path.with_name("validation.csv")
     if val.is_file():  # the lag to beds held at fixed angles: measured, not extrapolated
         v = pd.read_csv(val)
-        v = v[(v.engine == "liggghts") & (v.layers == 18)] if "fixed_lag" in v else v.iloc[:0]
-        if len(v) and math.isfinite(v.fixed_lag.iloc[0]):
-            lag, lag_se, how = float(v.fixed_lag.iloc[0]), float(v.fixed_lag_se.iloc[0]), "fixed"
+        if "fixed_lag" in v:
+            v = v[(v.engine == "liggghts") & (v.layers == granular3d_tables.SCENE_LAYERS)]
+            if len(v) and math.isfinite(v.fixed_lag.iloc[0]):
+                lag, lag_se, how = float(v.fixed_lag.iloc[0]), float(v.fixed_lag_se.iloc[0]), "fixed"
     pts = pts[(pts["engine"] == "liggghts") & (pts["group"] == "sweep")]
     rolls = sorted(pts["rolling"].unique())
     if not any(math.isclose(rolling, r, abs_tol=1e-9) for r in rolls):

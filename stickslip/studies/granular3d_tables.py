@@ -87,6 +87,16 @@ def points(runs):
     return pd.DataFrame(rows, columns=columns)  # the columns even when only held beds ran
 
 
+# The 10 d bed's lattice layers (cases/incline3d.toml): a run on the scene's own bed has
+# layers 0 in runs.csv and points.csv (granular3d.Job.layers None).
+SCENE_LAYERS = 18
+
+
+def bed_layers(layers):
+    """A row's bed as lattice layers: 0 stands for the scene's own, SCENE_LAYERS."""
+    return int(layers) or SCENE_LAYERS
+
+
 def _sweep(pts, kind, rolling):
     return pts[(pts.kind == kind) & (pts.engine == "liggghts") & (pts.group == "sweep") & (pts["rolling"] == rolling)]
 
@@ -236,7 +246,7 @@ def holds(runs):
         lo = float(stopped.hold_angle.max()) if len(stopped) else math.nan
         hi = float(flowing.hold_angle.min()) if len(flowing) else math.nan
         ordered = bool(np.isfinite(lo) and np.isfinite(hi) and lo < hi)
-        rows.append({"engine": engine, "layers": int(layers) or 18, "fill": int(fill), "angles": len(grp),
+        rows.append({"engine": engine, "layers": bed_layers(layers), "fill": int(fill), "angles": len(grp),
                      "highest_stopped": lo, "lowest_flowing": hi, "ordered": ordered,
                      "theta_stop": (lo + hi) / 2 if ordered and hi - lo < 1.5 * HOLD_STEP else math.nan,  # next angles
                      "depth_d": float(stopped.depth_at_stop.mean()) if len(stopped) else math.nan,
@@ -280,7 +290,7 @@ def validation(pts, hold_rows=None):
         w = weinhart_theta_stop(p.depth_at_stop_mean)
         wn = weinhart_theta_stop(p.grains_per_area_mean)
         zero, zero_se = p.theta_stop_mean + lag, math.hypot(p.theta_stop_se, lag_se)
-        rows.append({"engine": p.engine, "layers": int(p.layers) or 18, "depth_d": p.depth_at_stop_mean,
+        rows.append({"engine": p.engine, "layers": bed_layers(p.layers), "depth_d": p.depth_at_stop_mean,
                      "theta_stop": p.theta_stop_mean, "std": p.theta_stop_std, "se": p.theta_stop_se,
                      "fills": p.fills, "weinhart_at_depth": w, "difference": p.theta_stop_mean - w,
                      "z": _z(p.theta_stop_mean, p.theta_stop_se, w, 0.0),
@@ -314,7 +324,7 @@ def _fixed_columns(pts, hold_rows, p):
     """The validation's columns at fixed angles for point p (a ramp's row): the engine's own
     holds and the lag they show (fixed - ramp); an engine that held no bed there (but LIGGGHTS
     did) takes its ramp plus LIGGGHTS' lag on that bed."""
-    layers = int(p.layers) or 18
+    layers = bed_layers(p.layers)
     fixed, fixed_se, n, depth = fixed_angle(hold_rows, layers, p.engine)
     if n or p.engine == "liggghts":
         lag, lag_se = fixed - p.theta_stop_mean, math.hypot(fixed_se, p.theta_stop_se)
@@ -365,7 +375,7 @@ def engines(pts):
             continue
         q = q.iloc[0]
         for a in ("theta_stop", "theta_start"):
-            rows.append({"material": p.material, "nu_s": p.nu_s, "layers": int(p.layers) or 18, "angle": a,
+            rows.append({"material": p.material, "nu_s": p.nu_s, "layers": bed_layers(p.layers), "angle": a,
                          "liggghts": q[f"{a}_mean"], "liggghts_std": q[f"{a}_std"], "lammps": p[f"{a}_mean"],
                          "lammps_std": p[f"{a}_std"], "difference": p[f"{a}_mean"] - q[f"{a}_mean"],
                          "z": _z(p[f"{a}_mean"], p[f"{a}_se"], q[f"{a}_mean"], q[f"{a}_se"])})
@@ -394,7 +404,8 @@ def write_tables(out):
     pts = points(runs)
     hold_rows = holds(runs) if "hold_angle" in runs else None
     tables = {"points.csv": pts, "predictions.csv": predictions(pts), "hysteresis.csv": hysteresis(pts),
-              "rolling.csv": rolling_effect(pts), "validation.csv": validation(pts, hold_rows), "checks.csv": checks(pts),
+              "rolling.csv": rolling_effect(pts), "validation.csv": validation(pts, hold_rows),
+              "checks.csv": checks(pts),
               "engines.csv": engines(pts), "cost.csv": cost(runs)}
     if hold_rows is not None:
         tables["holds.csv"] = hold_rows
