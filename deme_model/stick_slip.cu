@@ -17,8 +17,9 @@
 //   STICKSLIP_RECORD       1: each body keeps its last contact's Fn, F_s, D, slip count and
 //                          evaluation time in owner wildcards (a body with one contact:
 //                          the paper's scenes, the contract's rows)
-// Everything is float, as the engine's force kernels are (overlapDepth is double).
-// Names without the ss_ prefix are the engine's (FullHertzianForceModel.cu lists them).
+// Everything is float, as the engine's force kernels are, but the distance to a plane
+// (step 0). Names without the ss_ prefix are the engine's (FullHertzianForceModel.cu lists
+// them; bodyAPos, bodyBPos and ARadius are its force kernel's locals).
 
 #ifndef STICKSLIP_HOOKE
 #define STICKSLIP_HOOKE 0
@@ -36,11 +37,32 @@
 #define STICKSLIP_RECORD 0
 #endif
 
-if (overlapDepth > 0) {
+// ---- step 0: the overlap. On an analytical plane the engine's overlapDepth is r less a
+// distance it rounds to float (planeSignedDistance: steps of ulp(r)), taken along a normal
+// turned by a float quaternion (a turning plane's is 1 +- ~2e-7 long, anew each step). The
+// paper's overlaps are ~3e-5 r, so each moves Fn by up to ~1 % (deme_model/README.md,
+// "Geometry in float"). The distance is taken again here in double, along the normal made
+// unit. For a plane the two differ by less than 1e-6 r; where they differ by more than
+// 1e-4 r, B is not a plane (a cylinder, whose B is on its axis: they differ by its radius)
+// and the engine's overlap stays.
+double ss_overlap = overlapDepth, ss_area = overlapArea;
+if (ContactType == deme::SPHERE_ANALYTICAL_CONTACT) {
+    const double ss_nx = B2A.x, ss_ny = B2A.y, ss_nz = B2A.z;
+    const double ss_dist = ((bodyAPos.x - bodyBPos.x) * ss_nx + (bodyAPos.y - bodyBPos.y) * ss_ny +
+                            (bodyAPos.z - bodyBPos.z) * ss_nz) /
+                           sqrt(ss_nx * ss_nx + ss_ny * ss_ny + ss_nz * ss_nz);
+    const double ss_rad = ARadius;
+    if (fabs(ss_dist - (ss_rad - overlapDepth)) <= 1e-4 * ss_rad) {
+        ss_overlap = ss_rad - ss_dist;
+        ss_area = deme::PI * (ss_rad * ss_rad - ss_dist * ss_dist);  // the engine's circle
+    }
+}
+
+if (ss_overlap > 0) {
     // A grain pair (A, B spheres) or a grain on a wall (B analytical or a mesh). The law's
     // n points from A to B: n = -B2A (B2A is the engine's normal, from B to A).
     const bool ss_pair = ContactType == deme::SPHERE_SPHERE_CONTACT;
-    const float ss_delta = (float)overlapDepth;
+    const float ss_delta = (float)ss_overlap;
 
     // ---- coefficients of this contact
     float ss_mu_s_c, ss_mu_k_c;
@@ -105,7 +127,7 @@ if (overlapDepth > 0) {
                                      nu[bodyBMatType]);
         const float ss_cor = CoR[bodyAMatType][bodyBMatType];
         const float ss_meff = (AOwnerMass * BOwnerMass) / (AOwnerMass + BOwnerMass);
-        const float ss_a = sqrtf(overlapArea / deme::PI);  // contact radius
+        const float ss_a = sqrtf(ss_area / deme::PI);  // contact radius
         const float ss_Sn = 2.f * ss_E * ss_a;
         const float ss_loge = (ss_cor < DEME_TINY_FLOAT) ? logf(DEME_TINY_FLOAT) : logf(ss_cor);
         const float ss_beta = ss_loge / sqrtf(ss_loge * ss_loge + deme::PI_SQUARED);

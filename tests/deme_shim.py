@@ -127,8 +127,13 @@ class Contact:
     def owned(self, name, owner=0):
         return float(self.own[L[name] * L["NO"] + owner])
 
-    def step(self, overlap, area, kin):
-        geo = np.array([overlap, area], np.float64)
+    def step(self, overlap, area, kin, a_pos=(0.0, 0.0, 0.0), b_pos=(0.0, 0.0, 0.0)):
+        """One step: the engine's overlap and area, kin (kinematics()) and A's centre and B's
+        point in double. Left at the origin with kinematics()' radius 0, a wall contact's
+        distances disagree (|0 - (0 - overlap)| > 0) and the model keeps the engine's overlap."""
+        geo = np.zeros(L["GEO_SIZE"])
+        geo[L["G_OVERLAP"]], geo[L["G_AREA"]] = overlap, area
+        geo[L["G_APOS"]:L["G_APOS"] + 3], geo[L["G_BPOS"]:L["G_BPOS"] + 3] = a_pos, b_pos
         kin = np.asarray(kin, F32)
         assert kin.shape == (L["KIN_SIZE"],)
         self.f(geo.ctypes.data, kin.ctypes.data, self.mat.ctypes.data, self.own.ctypes.data,
@@ -137,8 +142,8 @@ class Contact:
 
 
 def kinematics(b2a, va, vb, wa, wb, cpa, cpb, ts, time, contact_type, mats=(1, 1), masses=(1.0, 1.0),
-               qa=(0, 0, 0, 1), qb=(0, 0, 0, 1)):
-    """The kin array (shim/deme_shim_layout.h) from its parts."""
+               qa=(0, 0, 0, 1), qb=(0, 0, 0, 1), radius=0.0):
+    """The kin array (shim/deme_shim_layout.h) from its parts (radius: A's)."""
     kin = np.zeros(L["KIN_SIZE"])
     for key, value in (("K_B2A", b2a), ("K_ALINVEL", va), ("K_BLINVEL", vb), ("K_AROTVEL", wa), ("K_BROTVEL", wb),
                        ("K_LOCCPA", cpa), ("K_LOCCPB", cpb), ("K_AORIQ", qa), ("K_BORIQ", qb)):
@@ -146,6 +151,7 @@ def kinematics(b2a, va, vb, wa, wb, cpa, cpb, ts, time, contact_type, mats=(1, 1
     kin[L["K_AMASS"]], kin[L["K_BMASS"]] = masses
     kin[L["K_TS"]], kin[L["K_TIME"]], kin[L["K_CONTACT_TYPE"]] = ts, time, contact_type
     kin[L["K_AMAT"]], kin[L["K_BMAT"]] = mats
+    kin[L["K_ARADIUS"]] = radius
     return kin
 
 
@@ -154,23 +160,27 @@ SPHERE_SPHERE, SPHERE_ANALYTICAL = (1 << 4) | 1, (1 << 4) | 4  # deme::encodeTyp
 
 def contract_geometry(case, x, v, w):
     """The engine's view of a contract row's contact at one state (A = grain i): overlap, the
-    overlap area, B2A, and the kinematic array; the floor is an analytical plane z = 0 whose
-    owner sits at the origin, grain j a sphere. Positions in double, as the engine keeps them."""
+    overlap area, B2A, the kinematic array, A's centre and B's point; the floor is an
+    analytical plane z = 0 whose owner sits at the origin, grain j a sphere. Positions in
+    double, as the engine keeps them."""
     R = lc.R
     if case.geometry == "wall":
         b2a = np.array([0.0, 0.0, 1.0])
         delta = R - x[0, 2]
         cp = x[0] - b2a * (R - delta / 2)
         area = math.pi * (R * R - (R - delta) ** 2)
-        kin = kinematics(b2a, v[0], (0, 0, 0), w[0], (0, 0, 0), cp - x[0], cp, lc.DT, 0.0, SPHERE_ANALYTICAL)
+        kin = kinematics(b2a, v[0], (0, 0, 0), w[0], (0, 0, 0), cp - x[0], cp, lc.DT, 0.0, SPHERE_ANALYTICAL,
+                         radius=R)
+        b_pos = (0.0, 0.0, 0.0)
     else:
         d = x[0] - x[1]
         b2a = d / np.linalg.norm(d)
         delta = 2 * R - np.linalg.norm(d)
         cp = x[1] + (R - delta / 2) * b2a
         area = math.pi * (R * delta - delta * delta / 4)
-        kin = kinematics(b2a, v[0], v[1], w[0], w[1], cp - x[0], cp - x[1], lc.DT, 0.0, SPHERE_SPHERE)
-    return delta, area, b2a, kin
+        kin = kinematics(b2a, v[0], v[1], w[0], w[1], cp - x[0], cp - x[1], lc.DT, 0.0, SPHERE_SPHERE, radius=R)
+        b_pos = x[1]
+    return delta, area, b2a, kin, x[0], b_pos
 
 
 def variant_of(case, sweep):
@@ -205,9 +215,9 @@ def run_case(case, sweep=False):
         start = x
         for s in range(1, seg.steps + 1):
             x, v, w = runners._state(case, seg, s, start)
-            delta, area, b2a, kin = contract_geometry(case, x, v, w)
+            delta, area, b2a, kin, a_pos, b_pos = contract_geometry(case, x, v, w)
             kin[L["K_TIME"]] = k * lc.DT
-            force = c.step(delta, area, kin)
+            force = c.step(delta, area, kin, a_pos, b_pos)
             if delta > 0:
                 if sweep:
                     out["fn"][k] = c.owned("R_FN")

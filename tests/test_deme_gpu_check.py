@@ -7,7 +7,6 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 import contract_runners as runners
 import deme_shim
@@ -59,18 +58,18 @@ def test_contract_rows_prescribed_as_they_are_stated():
 def test_drag_bounds_pass_pyref_against_itself_and_catch_an_early_slip():
     """The drag's comparison on pyref's own run: every difference 0; the same run with the
     saw-tooth 12 steps earlier (as the engine gave with the grain placed as the scene states
-    it, 0.95 nm high) is out of the first slip's bound. The plane's step of overlap: float's
-    ulp of the 2 mm distance (2^-32 m) over the static overlap m g / kn."""
+    it, 0.95 nm high) is out of the first slip's bound. The fixed plane's ring on the
+    emulated float geometry is pyref's own start (Fn = W to 1e-3)."""
     from stickslip import analysis, columns
     from stickslip import scene as scene_mod
     from pyref import Simulation
 
     sc = scene_mod.load("drag")
-    g = sc.grains[0]
-    assert check.plane_quantum(sc) == pytest.approx(2.0 ** -32 / (sc.grain_mass(g) * 9.81 / sc.contact.kn), rel=1e-12)
+    ring = check.float_ring(sc)
+    assert 0 < ring < 1e-3
     df = columns.frame(sc, Simulation(sc).run())
     s = analysis.summarise(sc, df)
-    for key, bound in check.drag_bounds(sc).items():
+    for key, bound in check.drag_bounds(sc, ring).items():
         assert s[key] is not None and bound > 0
     f = check.fn_spread(sc, df)  # pyref starts at its static overlap: Fn = W to 1e-3
     assert abs(f["first"] - 1) < 1e-3 and f["min"] <= f["first"] <= f["max"] < 1 + 1e-3
@@ -79,7 +78,7 @@ def test_drag_bounds_pass_pyref_against_itself_and_catch_an_early_slip():
     for col in (f"{c}_fs", f"{c}_slip", f"{c}_ftx"):
         early[col] = np.r_[early[col].to_numpy()[12:], np.zeros(12)]
     s2 = analysis.summarise(sc, early)
-    assert abs(s2["first_slip_s"] - s["first_slip_s"]) > check.drag_bounds(sc)["first_slip_s"]
+    assert abs(s2["first_slip_s"] - s["first_slip_s"]) > check.drag_bounds(sc, ring)["first_slip_s"]
 
 
 def test_summary_reads_every_part(tmp_path):

@@ -38,9 +38,10 @@ def _slide_on_wall(c, steps, mats=(1, 1)):
     x = np.array([[0.0, 0.0, lc.R - lc.DELTA]])
     v = np.array([[lc.X / lc.DT, 0.0, 0.0]])
     for k in range(steps):
-        delta, area, b2a, kin = shim.contract_geometry(lc.Case("", "", "wall", (), 0.5, 0.5), x, v, np.zeros((1, 3)))
+        delta, area, b2a, kin, a_pos, b_pos = shim.contract_geometry(lc.Case("", "", "wall", (), 0.5, 0.5), x, v,
+                                                                     np.zeros((1, 3)))
         kin[shim.L["K_AMAT"]], kin[shim.L["K_BMAT"]] = mats
-        force = c.step(delta, area, kin)
+        force = c.step(delta, area, kin, a_pos, b_pos)
         trace["fn"][k], trace["F"][k] = force[2], (force[0], force[1], 0.0)
         trace["D"][k], trace["slips"][k] = c.wc[:3], int(c.wc[3])
     return trace
@@ -83,8 +84,9 @@ def test_sweep_coefficients_per_owner():
     x = np.array([[-(1 - lc.DELTA) / 2, 0.0, 0.0], [(1 - lc.DELTA) / 2, 0.0, 0.0]])
     v = np.array([[0.0, X / lc.DT, 0.0], [0.0, 0.0, 0.0]])
     for _ in range(25):
-        delta, area, _, kin = shim.contract_geometry(lc.Case("", "", "pair", (), 0.5, 0.5), x, v, np.zeros((2, 3)))
-        c.step(delta, area, kin)
+        delta, area, _, kin, a_pos, b_pos = shim.contract_geometry(lc.Case("", "", "pair", (), 0.5, 0.5), x, v,
+                                                                   np.zeros((2, 3)))
+        c.step(delta, area, kin, a_pos, b_pos)
         slips.append(int(c.wc[3]))
     assert list(np.nonzero(np.diff(np.r_[0, slips]))[0] + 1) == [13, 19, 25]
     assert c.owned("R_FN", 1) == 1.0 and c.owned("R_FY", 1) == -c.owned("R_FY", 0) != 0.0  # B's record: B's force
@@ -191,6 +193,75 @@ def test_turning_wall_velocity_at_its_surface_point():
                           shim.SPHERE_ANALYTICAL)
     force = c.step(delta, math.pi * (lc.R ** 2 - (lc.R - delta) ** 2), kin)
     assert force[1] == lc.KN * delta and force[0] == 0.0 and force[2] == 0.0, force
+
+
+def _float_turned_normal(beta):
+    """A plane's normal, +y turned by beta about z, as the engine has it: the prescribed
+    quaternion cast to float (adapters/deme.turning_prescription), then applyOriQToVector3's
+    formula in float (its length 1 + ~1e-7, not 1)."""
+    w, z = F32(math.cos(beta / 2)), F32(math.sin(beta / 2))
+    one, two = F32(1), F32(2)
+    return np.array([-(two * (w * z)), two * (w * w) - one, F32(0)], F32)
+
+
+@pytest.mark.parametrize("variant", ["ss_hooke_step_spring", "ss_hertz_step_spring"])
+def test_plane_distance_taken_in_double(variant):
+    """Step 0: on a plane the model takes the overlap from the grain's distance in double along
+    the normal made unit, not the engine's overlapDepth (r less a float distance, along a
+    float normal 1 + ~1e-7 long). The tilt's grain (r = 5 mm, overlap 1.67e-7 m = 3.3e-5 r,
+    at rest) on its plate turned by 200 angles up to 0.4676 rad: Fn is the exact overlap's,
+    kn delta (Hooke) or the engine's Hertz from delta and the circle pi (r^2 - d^2), within
+    float: ~20 roundings, 2e-6. The engine's own overlap is off by up to 0.45 % on these
+    angles (its float distance steps by ulp(r) = 4.7e-10 m, 0.28 %, and the normal's length
+    error r ~1e-7 adds ~0.3 %): the test checks that it is above 0.3 %, so that it can fail."""
+    r, delta, kn, m = F32(0.005), 1.67e-7, 1.2e7, 1.36e-3
+    hertz = "hertz" in variant
+    c = _hertz_contact(variant) if hertz else shim.Contact(variant)
+    if not hertz:
+        for name, value in (("kn", kn), ("ks", 9.6e6), ("mu", 0.5), ("mu_k", 0.45)):
+            c.pairwise(name, 1, 1, value)
+    worst_engine = worst_model = 0.0
+    for beta in np.linspace(0.0, 0.4676, 200):
+        n_exact = np.array([-math.sin(beta), math.cos(beta), 0.0])
+        n = _float_turned_normal(beta)
+        a_pos = (float(r) - delta) * n_exact  # above the plate's pivot, the plane's point
+        dist_engine = float(F32(a_pos @ n.astype(float)))  # planeSignedDistance: double dot, float result
+        overlap_engine = float(r) - dist_engine
+        area_engine = math.pi * (float(r) ** 2 - dist_engine ** 2)
+        cp = a_pos - n * (dist_engine + overlap_engine / 2)
+        kin = shim.kinematics(n, (0, 0, 0), (0, 0, 0), (0, 0, 0), (0, 0, 0), cp - a_pos, cp, 8e-6, 0.0,
+                              shim.SPHERE_ANALYTICAL, masses=(m, 1.0), radius=r)
+        c.wc[:] = 0
+        force = c.step(overlap_engine, area_engine, kin, a_pos, (0.0, 0.0, 0.0))
+        fn = float(force @ n.astype(float))
+        if hertz:
+            area = math.pi * (float(r) ** 2 - (float(r) - delta) ** 2)
+            want, _, _ = _hertz_reference(1e8, 0.3, 0.5, m, 1.0, delta, area, 0.0)
+        else:
+            want = kn * delta
+        worst_model = max(worst_model, abs(fn / want - 1))
+        worst_engine = max(worst_engine, abs(overlap_engine / delta - 1))
+    assert worst_model <= 2e-6, worst_model
+    assert worst_engine > 3e-3, worst_engine
+
+
+def test_non_plane_keeps_the_engines_overlap():
+    """Step 0 recomputes a plane's distance only: a grain inside a cylinder (radius 4, axis z
+    through B's point, the grain 2 along the axis from it) has the engine's overlap 1/32
+    (Fn = 1 exactly). Its distance along the normal is the cylinder's radius from the
+    engine's (r - overlap), beyond 1e-4 r: the model keeps overlapDepth. Taken as a plane it
+    would see an overlap of 4 and Fn = 129."""
+    c = shim.Contact("ss_hooke_step_spring")
+    for name, value in (("kn", lc.KN), ("ks", 1.0), ("mu", 0.5), ("mu_k", 0.45)):
+        c.pairwise(name, 1, 1, value)
+    delta, rc = lc.DELTA, 4.0
+    a_pos = np.array([rc - lc.R + delta, 0.0, 2.0])
+    b2a = np.array([-1.0, 0.0, 0.0])  # inward, towards the axis
+    cp = a_pos - b2a * (lc.R - delta / 2)
+    kin = shim.kinematics(b2a, (0, 0, 0), (0, 0, 0), (0, 0, 0), (0, 0, 0), cp - a_pos, cp, lc.DT, 0.0,
+                          shim.SPHERE_ANALYTICAL, radius=lc.R)
+    force = c.step(delta, math.pi * (2 * lc.R * delta - delta * delta), kin, a_pos, (0.0, 0.0, 0.0))
+    assert force[0] == -1.0 and force[1] == 0.0 and force[2] == 0.0, force
 
 
 def test_the_library_has_every_variant():

@@ -285,6 +285,14 @@ DEME_MUTANTS = (
            "if (!(ss_L > 0.f)) {", "if (!(ss_L >= 0.f)) {"),
     Mutant("record_b_force_sign", "a sign error in what the record keeps",
            "ss_rec_fy[BOwner] = -ss_F.y;", "ss_rec_fy[BOwner] = ss_F.y;"),
+    Mutant("plane_overlap_engines", "a plane's overlap from the engine's float distance",
+           "<= 1e-4 * ss_rad) {", "< 0.0) {"),
+    Mutant("plane_normal_not_unit", "a plane's distance along the engine's normal as it is",
+           "/ sqrt(ss_nx * ss_nx + ss_ny * ss_ny + ss_nz * ss_nz);", ";"),
+    Mutant("plane_area_engines", "a plane's contact area from the engine's float distance",
+           "ss_area = deme::PI * (ss_rad * ss_rad - ss_dist * ss_dist);", ""),
+    Mutant("cylinder_taken_as_plane", "a cylinder's overlap taken as a plane's",
+           "<= 1e-4 * ss_rad) {", "<= 1e30 * ss_rad) {"),
 )
 
 ENGINES = {

@@ -4,7 +4,7 @@
    text with one set of its options, and hands back what the model wrote.
 
    Arguments (flat arrays, layouts in deme_shim_layout.h):
-     geo   double[2]         overlapDepth, overlapArea
+     geo   double[GEO_SIZE]  overlapDepth, overlapArea, bodyAPos, bodyBPos
      kin   float[KIN_SIZE]   the contact's geometry and the bodies' motion (A is owner 0, B 1)
      mat   float[MAT_SIZE]   material properties: pairwise [NM][NM] arrays, then E[NM], nu[NM]
      own   float[OWN_SIZE]   owner wildcards, [name][NO] (sweep coefficients, the record)
@@ -20,7 +20,10 @@
 #define F3(p) make_float3((p)[0], (p)[1], (p)[2])
 
 #define SHIM_PROLOGUE                                                                                            \
-  double overlapDepth = geo[0], overlapArea = geo[1];                                                            \
+  double overlapDepth = geo[G_OVERLAP], overlapArea = geo[G_AREA];                                              \
+  double3 bodyAPos = {geo[G_APOS], geo[G_APOS + 1], geo[G_APOS + 2]};                                            \
+  double3 bodyBPos = {geo[G_BPOS], geo[G_BPOS + 1], geo[G_BPOS + 2]};                                            \
+  float ARadius = kin[K_ARADIUS];                                                                                \
   float3 B2A = F3(kin + K_B2A), ALinVel = F3(kin + K_ALINVEL), BLinVel = F3(kin + K_BLINVEL);                    \
   float3 ARotVel = F3(kin + K_AROTVEL), BRotVel = F3(kin + K_BROTVEL);                                           \
   float3 locCPA = F3(kin + K_LOCCPA), locCPB = F3(kin + K_LOCCPB);                                               \

@@ -1,7 +1,7 @@
 /* stickslip: the few names of DEM-Engine's force kernels that deme_model/stick_slip.cu uses,
    for the CPU (g++), so that the same file is compiled and run on a machine without a GPU
    (tests/deme_shim.py). Written from DEM-Engine 3.0.19's kernel sources, by signature:
-   float3/float4 and make_float3/make_float4 (CUDA's vector types), the arithmetic of its
+   float3/float4/double3 and make_float3/make_float4 (CUDA's vector types), the arithmetic of its
    CUDAMathHelpers.cuh (float3 + - and scalar * /, dot, cross, length; unary minus binds to
    an lvalue only, as there), applyOriQToVector3 and matProxy2ContactParam
    (DEMHelperKernels.cuh), and the constants of DEM/Defines.h the model reads. Every
@@ -19,6 +19,9 @@ struct float3 {
 };
 struct float4 {
   float x, y, z, w;
+};
+struct double3 {
+  double x, y, z;
 };
 
 inline float3 make_float3(float x, float y, float z) { return float3{x, y, z}; }

@@ -27,8 +27,13 @@ enum {
   K_CONTACT_TYPE = 33,
   K_AMAT = 34,
   K_BMAT = 35,
-  KIN_SIZE = 36
+  K_ARADIUS = 36,   // A's radius (float, as the engine keeps it)
+  KIN_SIZE = 37
 };
+
+// geo (double): the overlap and its area as the engine computed them, then A's centre and
+// B's point (a plane's point; a sphere's centre), global
+enum { G_OVERLAP = 0, G_AREA = 1, G_APOS = 2, G_BPOS = 5, GEO_SIZE = 8 };
 
 // mat: pairwise properties [NM][NM] in this order, then E[NM] and nu[NM]
 enum { M_KN = 0, M_NU_N, M_KS, M_NU_S, M_MU, M_MU_K, M_COR, M_PAIRWISE };
