@@ -7,9 +7,9 @@ own distance in double (deme_model/stick_slip.cu, step 0).
 
 Each step does what DEM-Engine 3.0.19's sphere-plane force kernel does before the model
 (DEMCalcForceKernels_Primitive.cu, DEMCollisionKernels_SphSph.cuh):
-  - the plate's quaternion is the adapter's prescription cast to float
-    (adapters/deme.turning_prescription) and turns the plane's normal in float
-    (applyOriQToVector3): a normal 1 +- ~1e-7 long;
+  - the plate's quaternion is the adapter's prescription (adapters/deme.turning_prescription)
+    of the engine's time, which the engine hands it as float, cast to float, and turns the
+    plane's normal in float (applyOriQToVector3): a normal 1 +- ~2e-7 long;
   - the plane's point is its owner plus the turned relative position (wall_placement);
   - the distance is dot(A - B, n) in double, returned as float (planeSignedDistance), and
     the overlap is the float radius less it; the contact point and lever arms follow;
@@ -104,8 +104,12 @@ def emulate(scene, model_distance, steps=None):
     angles = np.zeros((rows + 1, 1))
     xs[0, 0], vs[0, 0] = (x + o)[:scene.dimension], v[:scene.dimension]
     last = 0
+    fdt = float(F32(dt))
     for k in range(steps):
-        angle = adapter.wall_angle(scene, w, k)
+        # the prescription's angle, rate min(t + dt, stop time), of the engine's time t at the
+        # step before, a double sum of the float step passed to it as float
+        t_engine = float(F32(max(k - 1, 0) * fdt))
+        angle = rate * min(t_engine + dt, rot_steps * dt) if k >= 1 else 0.0
         q = plate_quaternion(scene, w, angle)
         n = rotate_f32(normal0, q)  # the plane's normal, float
         b_pos = owner + rotate_f32(rel, q).astype(float)
