@@ -81,6 +81,41 @@ def test_drag_bounds_pass_pyref_against_itself_and_catch_an_early_slip():
     assert abs(s2["first_slip_s"] - s["first_slip_s"]) > check.drag_bounds(sc, ring)["first_slip_s"]
 
 
+def test_compare_case_beside_the_emulation(tmp_path, monkeypatch):
+    """compare_case on the drag with a stand-in engine that returns pyref's own run: every row
+    within its bound, each with the emulated engine's figure beside it, the ring from the
+    emulation (pyref's start: < 1e-3), and the summary prints them; with the shim missing
+    (the emulation fails) the bounds that take the ring are nan, their rows OUT, said in one
+    line."""
+    import argparse
+    from types import SimpleNamespace
+
+    from stickslip import columns
+    from stickslip.adapters import deme as adapter
+    from pyref import Simulation
+
+    monkeypatch.setattr(adapter, "run", lambda sc, out: SimpleNamespace(
+        timeseries=columns.frame(sc, Simulation(sc).run()), notes=["stand-in"]))
+    args = argparse.Namespace(work=str(tmp_path), tilt_every=50)
+    res = check.compare_case("drag", args, log=lambda s: None)
+    assert res["float_ring"] < 1e-3 and res["fn"]["emulated"]
+    assert all(r["ok"] and r["emulated"] is not None for r in res["rows"]), res["rows"]
+    res["ok"] = True
+    (tmp_path / "drag.json").write_text(json.dumps(res))
+    text = check.summary(argparse.Namespace(work=str(tmp_path), parts=["drag"]), 1.0)
+    assert "fs_fn_min" in text and "(emulated 0.4" in text, text
+    said = []
+
+    def no_shim(sc):
+        raise OSError("no libstickslip_deme_shim.so")
+
+    monkeypatch.setattr(check, "emulated", no_shim)
+    res = check.compare_case("drag", args, log=said.append)
+    out = {r["quantity"] for r in res["rows"] if not r["ok"]}
+    assert out == {"fs_fn_min", "fs_fn_mean", "first_slip_s", "slip_period_s"}, out
+    assert any("no emulated float geometry" in s for s in said)
+
+
 def test_summary_reads_every_part(tmp_path):
     """The printed summary from each part's JSON (a failed part prints its error)."""
     work = tmp_path / "w"

@@ -274,17 +274,27 @@ def judge_row(case, trace):
 # step, and the plate moves under the grain's foot by that times the foot's distance from the
 # pivot (2 mm at the tilt's end); the normal oscillator, damped little (restitution 0.96),
 # rings with it. float_ring measures that ring on the CPU emulation of the engine's geometry.
-def float_ring(sc):
-    """How far Fn strays relatively before the first slip on the engine's float geometry with
-    the model's own distance, emulated on the CPU (tools/deme_plane_emulation.py, the force
-    model through its shim): max |Fn / (W cos beta) - 1| over the rows (pyref's own start
-    included: 3.7e-4 on both cases). The drag's fixed plane has an exact normal: pyref's;
-    the tilt's turning one rings by ~0.3 %. Recorded as the scene is (its output.every)."""
+def emulated(sc):
+    """The scene's run on the engine's float geometry with the model's own distance, emulated
+    on the CPU (tools/deme_plane_emulation.py, the force model through its shim), recorded as
+    the scene is (its output.every): its timeseries."""
     import deme_plane_emulation as emulation
     from stickslip import columns
 
-    f = fn_spread(sc, columns.frame(sc, emulation.emulate(sc, model_distance=True)))
+    return columns.frame(sc, emulation.emulate(sc, model_distance=True))
+
+
+def ring_of(sc, df):
+    """How far Fn strays relatively before the first slip: max |Fn / (W cos beta) - 1|."""
+    f = fn_spread(sc, df)
     return max(1.0 - f["min"], f["max"] - 1.0)
+
+
+def float_ring(sc):
+    """Fn's ring on the emulated float geometry (emulated, ring_of), pyref's own start
+    included (3.7e-4 on both cases): the drag's fixed plane has an exact normal, pyref's
+    ring; the tilt's turning one rings by ~0.3 %."""
+    return ring_of(sc, emulated(sc))
 
 
 def drag_bounds(sc, e):
@@ -325,11 +335,12 @@ def compare_case(name, args, log):
     log(f"{name}: DEM-Engine {t_run:.0f} s with its initialisation ({res.notes[0]})")
     t0 = time.perf_counter()
     try:
-        ring = float_ring(sc)
+        emu = emulated(sc)
+        ring, s_e = ring_of(sc, emu), analysis.summarise(sc, emu)
         log(f"{name}: Fn's ring on the emulated float geometry {ring:.3g} ({time.perf_counter() - t0:.0f} s, CPU)")
-    except Exception as e:  # (the CPU shim neither carried nor built: bounds of nan, every row OUT)
-        ring = math.nan
-        log(f"{name}: no emulated float geometry, so no bounds: {type(e).__name__}: {e}"[:400])
+    except Exception as e:  # (the CPU shim neither carried nor built: the ring's bounds nan, their rows OUT)
+        emu, ring, s_e = None, math.nan, {}
+        log(f"{name}: no emulated float geometry, so no bounds that take Fn's ring: {type(e).__name__}: {e}"[:400])
     if name == "drag":
         bounds = drag_bounds(sc, ring)
     else:
@@ -340,10 +351,11 @@ def compare_case(name, args, log):
         a, b = s_d.get(key), s_p.get(key)
         ok = a is not None and b is not None and abs(a - b) <= bound
         rows.append({"quantity": key, "deme": a, "pyref": b, "diff": None if a is None or b is None else a - b,
-                     "bound": bound, "ok": bool(ok)})
+                     "bound": bound, "ok": bool(ok), "emulated": s_e.get(key)})
     return {"wall_s": t_run, "notes": res.notes, "rows": rows, "float_ring": ring, "deme_summary": _plain(s_d),
             "pyref_summary": _plain(s_p),
-            "fn": {"deme": fn_spread(sc, df), "pyref": fn_spread(sc, ref)}}
+            "fn": {"deme": fn_spread(sc, df), "emulated": fn_spread(sc, emu) if emu is not None else {},
+                   "pyref": fn_spread(sc, ref)}}
 
 
 def fn_spread(sc, df):
@@ -719,7 +731,8 @@ def summary(args, elapsed):
             lines.append(f"{name} against pyref (DEM-Engine run {d['wall_s']:.0f} s with its initialisation):")
             for r in d["rows"]:
                 lines.append(f"  {r['quantity']:22s} deme {r['deme']!s:>22.22} pyref {r['pyref']!s:>22.22} "
-                             f"diff {r['diff']!s:>11.11} bound {r['bound']:.3g} {'ok' if r['ok'] else 'OUT'}")
+                             f"diff {r['diff']!s:>11.11} bound {r['bound']:.3g} {'ok' if r['ok'] else 'OUT'} "
+                             f"(emulated {r.get('emulated')!s:.10})")
             for who, f in (d.get("fn") or {}).items():
                 if f:
                     lines.append(f"  Fn / (W cos angle) before the first slip, {who}: first {f['first']:.6f}, "
