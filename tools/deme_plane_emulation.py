@@ -68,7 +68,7 @@ def conjugate(q):
     return (-q[0], -q[1], -q[2], q[3])
 
 
-def emulate(scene, model_distance, steps=None):
+def emulate(scene, model_distance):
     """One run (see the module's text): a pyref-like Recording of the scene's output."""
     import deme_shim as shim
     from stickslip.adapters import deme as adapter
@@ -82,7 +82,7 @@ def emulate(scene, model_distance, steps=None):
                         ("mu_k", p.mu_k)):
         contact.pairwise(name, 1, 1, value)
     dt, every = scene.dt, scene.output.every
-    steps = scene.steps if steps is None else steps
+    steps = scene.steps
     m = scene.grain_mass(g)
     radius = F32(g.radius)
     gravity = np.array(scene.gravity[:3], float) if eff["gravity"] else np.zeros(3)
@@ -146,9 +146,7 @@ def emulate(scene, model_distance, steps=None):
             count = int(contact.wc[3])
             slips[r, 0], last = (count - last if count >= last else count), count
             angles[r, 0] = adapter.wall_angle(scene, w, k + 1)
-    from stickslip.adapters.deme import _Recording
-
-    return _Recording(t, xs, vs, fn, ft, slips, angles)
+    return adapter._Recording(t, xs, vs, fn, ft, slips, angles)
 
 
 def report(name, steps=None, log=print):
