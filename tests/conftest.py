@@ -117,6 +117,9 @@ def pytest_runtest_protocol(item, nextitem):
 
 
 def pytest_collection_modifyitems(config, items):
+    # The default suite's long tests (marked long, 14-50 s each) run first: started last, one
+    # of them would keep one worker busy after the other has run out of tests.
+    items[:] = [i for i in items if "long" in i.keywords] + [i for i in items if "long" not in i.keywords]
     if config.getoption("--runslow"):
         return
     skip = pytest.mark.skip(reason="long run: opt in with --runslow")

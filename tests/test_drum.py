@@ -251,6 +251,7 @@ def assert_refused_in_one_line(argv, words, tmp_path, capsys):
 
 # ---------------------------------------------------------------- the study's smoke version
 
+@pytest.mark.long
 @needs_liggghts
 def test_drum_study_smoke(tmp_path, monkeypatch):
     """The study's code path on the small drum (cases/drum_small.toml: 80 disks), history

@@ -153,6 +153,7 @@ def test_thousands_of_slips_in_one_step_stay_finite_and_cheap(dim, monkeypatch):
     assert max(work) == min(work), work
 
 
+@pytest.mark.long
 def test_drag_and_tray_agree_in_both_modes_within_half_a_percent():
     """The resolved cases: slips there follow >= 100 stick steps, so placing them inside
     the step moves the headline figures by O(1/100) of one tooth's share: under 0.5 %.
@@ -169,6 +170,7 @@ def test_drag_and_tray_agree_in_both_modes_within_half_a_percent():
             assert exact[k] == pytest.approx(step[k], rel=0.005), (case, k)
 
 
+@pytest.mark.long
 def test_tilt_exact_mode_is_within_one_percent_of_converged_at_the_scenes_dt(tmp_path):
     """The speed history after the first slip at the scene's dt (8e-6 s) against the same
     at dt/2: the exact mode converges with order >= 1 (docs/precision.md measures ~2), so

@@ -69,6 +69,7 @@ def test_drag_matches_pyref(tmp_path):
     assert_series_agree(sc, dl, dp)
 
 
+@pytest.mark.long
 @needs_liggghts
 def test_tilt_matches_pyref(tmp_path):
     """The turning plate is a mesh wall moved by fix move/mesh rotate/variable."""

@@ -89,6 +89,7 @@ def test_tray_height_follows_the_force_after_a_slip():
 # Coulomb's creep is a time-step effect (its force flips every step): in the calibrated
 # tray it would take ~1100 s; in tray_wedge (2 um narrower than two diameters) it falls
 # within the scene's 2.5 s, as the paper's Fig. 11 shows.
+@pytest.mark.long
 @pytest.mark.parametrize("case,law", [("tray_wedge", "coulomb"), ("tray", "visco_plastic")])
 def test_tray_coulomb_and_visco_plastic_reach_the_bottom(case, law):
     sc, df = paper_case(case, law=law)

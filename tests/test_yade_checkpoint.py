@@ -139,6 +139,7 @@ def test_checkpoints_continue_bit_identically(tmp_path):
             assert got[field] == ref[field], (path, field)
 
 
+@pytest.mark.long
 def test_checkpoints_pile_first_resumed_step_bit_identical(tmp_path):
     # Checkpoint at step 7000 (the pile is forming: ~50 contacts), one step on.
     runs = resumed_runs(tmp_path, "pile", 7000, 7001)

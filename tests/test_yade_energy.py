@@ -86,6 +86,7 @@ def check_balance(r):
     assert max(abs(t - total[0]) for t in total) <= omega * DT * scale
 
 
+@pytest.mark.long
 def test_energy_balance_of_a_pour_step_mode(tmp_path):
     # nu_s/Ks = 3.75e-6 s below dt: with the reset of eq. 8 (Ks|D| = Fmin) a slip step
     # never gives energy back then. (With nu_s/Ks > dt the reset can load the spring with

@@ -95,6 +95,7 @@ def test_drag_is_pyrefs_twin(tmp_path, timing):
     assert dy["grain-floor_slip"].sum() >= 5  # the saw-tooth is there
 
 
+@pytest.mark.long
 @needs_yade
 @pytest.mark.parametrize("timing", ["step", "exact"])
 def test_tilt_is_pyrefs_twin(tmp_path, timing):
@@ -105,6 +106,7 @@ def test_tilt_is_pyrefs_twin(tmp_path, timing):
     assert dy["grain-plate_slip"].sum() > 100
 
 
+@pytest.mark.long
 @needs_yade
 def test_tray_is_pyrefs_twin(tmp_path):
     """The tray's first 0.5 s (the impact, whose slips fix the grain-grain friction that
@@ -126,6 +128,7 @@ def test_relative_output_folder(tmp_path, monkeypatch):
     assert len(res.timeseries) == sc.steps // sc.output.every + 1
 
 
+@pytest.mark.long
 @needs_yade
 def test_poured_packing_statistics_match_pyref(tmp_path):
     """120 polydisperse disks poured into a tray (Table 2 parameters, rotation on), on
