@@ -116,25 +116,10 @@ def pytest_runtest_protocol(item, nextitem):
         f.write(f"{_cpu_seconds() - t0:.2f}\t{item.nodeid}\n")
 
 
-def long_tests_first(items, workers):
-    """The default suite's long tests (marked long, 14-50 s each) at the front of each
-    worker's first share, dealt in turn: started last, one of them would keep its worker busy
-    after the others have run out of tests. pytest-xdist's worksteal hands the k workers
-    consecutive shares of the collection, share j holding (what is left) // (k - j) items."""
-    longs = [i for i in items if "long" in i.keywords]
-    rest = [i for i in items if "long" not in i.keywords]
-    shares, left, taken = [longs[j::workers] for j in range(workers)], len(items), 0
-    for j, share in enumerate(shares):
-        size = left // (workers - j)
-        left -= size
-        need = max(size - len(share), 0)
-        share += rest[taken:taken + need]
-        taken += need
-    items[:] = [i for share in shares for i in share] + rest[taken:]
-
-
 def pytest_collection_modifyitems(config, items):
-    long_tests_first(items, int(getattr(config, "workerinput", {}).get("workercount", 1)))
+    # The default suite's long tests (marked long, 14-50 s each) run first: started last, one
+    # of them would keep one worker busy after the other has run out of tests.
+    items[:] = [i for i in items if "long" in i.keywords] + [i for i in items if "long" not in i.keywords]
     if config.getoption("--runslow"):
         return
     skip = pytest.mark.skip(reason="long run: opt in with --runslow")
