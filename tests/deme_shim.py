@@ -141,6 +141,18 @@ class Contact:
         return self.force.astype(np.float64)
 
 
+def apply_ori_q(v, q):
+    """The engine's applyOriQToVector3 in float (as on its GPU, without fused multiply-adds):
+    v turned by the quaternion q = (x, y, z, w), both taken as float."""
+    X, Y, Z = (F32(c) for c in v)
+    x, y, z, w = (F32(c) for c in q)
+    one, two = F32(1), F32(2)
+    return np.array([(two * (w * w + x * x) - one) * X + (two * (x * y - w * z)) * Y + (two * (x * z + w * y)) * Z,
+                     (two * (x * y + w * z)) * X + (two * (w * w + y * y) - one) * Y + (two * (y * z - w * x)) * Z,
+                     (two * (x * z - w * y)) * X + (two * (y * z + w * x)) * Y + (two * (w * w + z * z) - one) * Z],
+                    F32)
+
+
 def kinematics(b2a, va, vb, wa, wb, cpa, cpb, ts, time, contact_type, mats=(1, 1), masses=(1.0, 1.0),
                qa=(0, 0, 0, 1), qb=(0, 0, 0, 1), radius=0.0):
     """The kin array (shim/deme_shim_layout.h) from its parts (radius: A's)."""

@@ -19,6 +19,11 @@ def _outside(runs, bounds, label):
     return sorted(k for k, b in bounds.items() if abs(runs[label][k] - runs["pyref"][k]) > b)
 
 
+def _ring(figures):
+    """float_ring from a run's figures (report's fn_over_w_*), without a second run."""
+    return check.ring_of({k: figures[f"fn_over_w_{k}"] for k in ("min", "max")})
+
+
 def test_drag_keeps_its_bounds_on_the_models_distance_only():
     """The drag (a fixed plane, normal exact in float): on the model's distance every figure
     is within drag_bounds of pyref's and Fn/W within pyref's start (1e-3); on the engine's
@@ -28,7 +33,7 @@ def test_drag_keeps_its_bounds_on_the_models_distance_only():
 
     sc = scene_mod.load("drag")
     runs = emulation.report("drag", log=lambda s: None)
-    bounds = check.drag_bounds(sc, check.float_ring(sc))
+    bounds = check.drag_bounds(sc, _ring(runs["model distance"]))
     assert _outside(runs, bounds, "model distance") == []
     model = runs["model distance"]
     assert 1 - 1e-3 < model["fn_over_w_min"] <= model["fn_over_w_max"] < 1 + 1e-3
@@ -47,8 +52,7 @@ def test_tilt_keeps_its_bounds_on_the_models_distance_only():
 
     sc = scene_mod.load("tilt")
     runs = emulation.report("tilt", log=lambda s: None)
-    model = runs["model distance"]
-    ring = max(1 - model["fn_over_w_min"], model["fn_over_w_max"] - 1)  # (float_ring, without a second run)
+    ring = _ring(runs["model distance"])
     assert ring < 0.01
     bounds = check.tilt_bounds(sc, None, runs["pyref"], ring)
     assert _outside(runs, bounds, "model distance") == []

@@ -199,9 +199,7 @@ def _float_turned_normal(beta):
     """A plane's normal, +y turned by beta about z, as the engine has it: the prescribed
     quaternion cast to float (adapters/deme.turning_prescription), then applyOriQToVector3's
     formula in float (its length 1 + ~1e-7, not 1)."""
-    w, z = F32(math.cos(beta / 2)), F32(math.sin(beta / 2))
-    one, two = F32(1), F32(2)
-    return np.array([-(two * (w * z)), two * (w * w) - one, F32(0)], F32)
+    return shim.apply_ori_q((0.0, 1.0, 0.0), (0.0, 0.0, F32(math.sin(beta / 2)), F32(math.cos(beta / 2))))
 
 
 @pytest.mark.parametrize("variant", ["ss_hooke_step_spring", "ss_hertz_step_spring"])

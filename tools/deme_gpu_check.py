@@ -284,17 +284,17 @@ def emulated(sc):
     return columns.frame(sc, emulation.emulate(sc, model_distance=True))
 
 
-def ring_of(sc, df):
-    """How far Fn strays relatively before the first slip: max |Fn / (W cos beta) - 1|."""
-    f = fn_spread(sc, df)
-    return max(1.0 - f["min"], f["max"] - 1.0)
+def ring_of(spread):
+    """How far Fn strays relatively before the first slip, from fn_spread's figures:
+    max |Fn / (W cos beta) - 1|."""
+    return max(1.0 - spread["min"], spread["max"] - 1.0)
 
 
 def float_ring(sc):
     """Fn's ring on the emulated float geometry (emulated, ring_of), pyref's own start
     included (3.7e-4 on both cases): the drag's fixed plane has an exact normal, pyref's
     ring; the tilt's turning one rings by ~0.3 %."""
-    return ring_of(sc, emulated(sc))
+    return ring_of(fn_spread(sc, emulated(sc)))
 
 
 def drag_bounds(sc, e):
@@ -336,10 +336,11 @@ def compare_case(name, args, log):
     t0 = time.perf_counter()
     try:
         emu = emulated(sc)
-        ring, s_e = ring_of(sc, emu), analysis.summarise(sc, emu)
+        f_e, s_e = fn_spread(sc, emu), analysis.summarise(sc, emu)
+        ring = ring_of(f_e)
         log(f"{name}: Fn's ring on the emulated float geometry {ring:.3g} ({time.perf_counter() - t0:.0f} s, CPU)")
     except Exception as e:  # (the CPU shim neither carried nor built: the ring's bounds nan, their rows OUT)
-        emu, ring, s_e = None, math.nan, {}
+        f_e, ring, s_e = {}, math.nan, {}
         log(f"{name}: no emulated float geometry, so no bounds that take Fn's ring: {type(e).__name__}: {e}"[:400])
     if name == "drag":
         bounds = drag_bounds(sc, ring)
@@ -354,8 +355,7 @@ def compare_case(name, args, log):
                      "bound": bound, "ok": bool(ok), "emulated": s_e.get(key)})
     return {"wall_s": t_run, "notes": res.notes, "rows": rows, "float_ring": ring, "deme_summary": _plain(s_d),
             "pyref_summary": _plain(s_p),
-            "fn": {"deme": fn_spread(sc, df), "emulated": fn_spread(sc, emu) if emu is not None else {},
-                   "pyref": fn_spread(sc, ref)}}
+            "fn": {"deme": fn_spread(sc, df), "emulated": f_e, "pyref": fn_spread(sc, ref)}}
 
 
 def fn_spread(sc, df):

@@ -42,17 +42,6 @@ sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "tools")]
 F32 = np.float32
 
 
-def rotate_f32(v, q):
-    """applyOriQToVector3 in float: v turned by the quaternion q = (x, y, z, w)."""
-    X, Y, Z = (F32(c) for c in v)
-    x, y, z, w = (F32(c) for c in q)
-    one, two = F32(1), F32(2)
-    return np.array([(two * (w * w + x * x) - one) * X + (two * (x * y - w * z)) * Y + (two * (x * z + w * y)) * Z,
-                     (two * (x * y + w * z)) * X + (two * (w * w + y * y) - one) * Y + (two * (y * z - w * x)) * Z,
-                     (two * (x * z - w * y)) * X + (two * (y * z + w * x)) * Y + (two * (w * w + z * z) - one) * Z],
-                    F32)
-
-
 def plate_quaternion(scene, w, angle):
     """The prescribed quaternion (x, y, z, w) of a wall turned by angle, cast to float as the
     adapter's prescription does."""
@@ -111,15 +100,15 @@ def emulate(scene, model_distance):
         t_engine = float(F32(max(k - 1, 0) * fdt))
         angle = rate * min(t_engine + dt, rot_steps * dt) if k >= 1 else 0.0
         q = plate_quaternion(scene, w, angle)
-        n = rotate_f32(normal0, q)  # the plane's normal, float
-        b_pos = owner + rotate_f32(rel, q).astype(float)
+        n = shim.apply_ori_q(normal0, q)  # the plane's normal, float
+        b_pos = owner + shim.apply_ori_q(rel, q).astype(float)
         dist = float(F32((x - b_pos) @ n.astype(float)))  # double dot, returned as float
         overlap = float(radius) - dist
         force = np.zeros(3)
         if overlap > 0:
             area = math.pi * (float(radius) ** 2 - dist * dist)
             cp = x - n.astype(float) * (dist + overlap / 2)
-            cp_b = rotate_f32((cp - owner).astype(F32), conjugate(q))
+            cp_b = shim.apply_ori_q((cp - owner).astype(F32), conjugate(q))
             spin = rate * axis if 1 <= k <= rot_steps else np.zeros(3)
             kin = shim.kinematics(n, v, (0, 0, 0), (0, 0, 0), spin, cp - x, cp_b, dt, k * dt,
                                   shim.SPHERE_ANALYTICAL, masses=(m, 1.0),
