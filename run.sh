@@ -112,9 +112,12 @@ case "${1:-}" in
     test)
         setup
         shift
-        # both cores (pytest-xdist; STICKSLIP_TEST_JOBS=0 runs them in this process): tests are
-        # independent, and the runs several tests read are made once (tests/conftest.py)
-        .venv/bin/python -m pytest -q -n "${STICKSLIP_TEST_JOBS:-auto}" --dist worksteal "$@"
+        # pytest-xdist workers, two per core (STICKSLIP_TEST_JOBS=N: N workers, 0: this process):
+        # many tests wait on engine processes (MPI start-up, YADE's import, a shared run another
+        # worker is making), and a second worker per core fills those waits (docs/testing.md,
+        # History: 2 workers 364-376 s, 3 312 s, 4 292 s). Tests are independent, and the runs
+        # several tests read are made once (tests/conftest.py).
+        .venv/bin/python -m pytest -q -n "${STICKSLIP_TEST_JOBS:-$((2 * $(nproc)))}" --dist worksteal "$@"
         ;;
     setup)
         setup

@@ -118,9 +118,9 @@ def pytest_runtest_protocol(item, nextitem):
 
 def pytest_collection_modifyitems(config, items):
     # The default suite's long tests (marked long, 14-50 s each) run first: started last, one
-    # of them would keep one worker busy after the other has run out of tests. (xdist's
-    # worksteal gives them all to the first worker, whose short tests the other steals;
-    # dealing them to both workers' shares in turn measured slower: docs/testing.md.)
+    # of them would keep one worker busy after the others have run out of tests. (xdist's
+    # worksteal gives them all to the first worker, whose short tests the others steal;
+    # dealing them to two workers' shares in turn measured slower: docs/testing.md.)
     items[:] = [i for i in items if "long" in i.keywords] + [i for i in items if "long" not in i.keywords]
     if config.getoption("--runslow"):
         return
