@@ -256,16 +256,17 @@ def assert_refused_in_one_line(argv, words, tmp_path, capsys):
 def test_drum_study_smoke(tmp_path, monkeypatch):
     """The study's code path on the small drum (cases/drum_small.toml: 80 disks), history
     mu = 0.5 against stick-slip 0.5/0.35 (step timing), 20 s each on one LIGGGHTS rank
-    (~15 s each on an idle core). What this size can show:
+    (17-21 s each on an idle core). What this size can show:
     - the drum turns and avalanches happen, in both (the spin-up's is not counted);
     - in an avalanche every slipping grain-grain contact carries exactly mu Fn (history)
       and exactly Fmin = (2 mu_k - mu_s) Fn = 0.2 Fn (stick-slip, step timing: the force
       is set to Fmin at each slip, eq. 8), the mechanism behind the study's finding;
     - a study interrupted in its second run keeps the first and, resumed, runs only the
       second; a third call runs nothing and writes the same table.
-    What it cannot show: the angles' differences. With 2-4 avalanches a run and a spread
-    of ~4 deg between avalanches, their means are ~2-3 deg uncertain, as large as the
-    differences the full study measures (docs/drum.md)."""
+    What it cannot show: the angles' differences. Each run has one avalanche after its
+    settling (history at 10.1 s, stick-slip at 11.2 s; history has a slide at 7.5 s too),
+    and avalanches spread by ~4 deg, as much as the differences the full study measures
+    (docs/drum.md)."""
     from stickslip.studies import drum_study
 
     kw = dict(out=tmp_path / "out", out_runs=tmp_path / "runs", rate=0.03, duration=20.0,
