@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# A whole GPU check in one call of the device machine (one command of at most 600 s, at most
+# 8 files back; a warm machine is given back after ~30 s idle, so a second call would start a
+# fresh one):
+#
+#   OUT=$OUT bash tools/gpu_session.sh BUNDLE [JIT_CACHE]     (carry: .gpu and build/deme_shim)
+#
+# 1. $OUT/check: the contract rows, drag, tilt and the tilt's spread (tools/gpu_check.sh),
+#    their solvers compiling side by side: ~160-330 s when the force model changed since
+#    JIT_CACHE was made, seconds of compiling when it did not.
+# 2. $OUT/bench: the bench with the GPU to itself (20 rounds of 500 steps, adaptive detection
+#    and every 20 steps): ~90 s on a warm cache, plus up to ~160 s for a cold compile of the
+#    stick-slip model's bench kernels (the kernels of step 1 are other ones).
+# Keeps 8 files: each step's summary.txt, results.json and parts.log, the first gpu.txt and
+# the last jit-cache.tar.xz (which holds both steps' kernels: put it in .gpu for the next run).
+set -uo pipefail
+cd "$(dirname "$0")/.."
+BUNDLE=${1:?usage: OUT=DIR bash tools/gpu_session.sh BUNDLE [JIT_CACHE]}
+CACHE=${2:-}
+OUT=${OUT:?set OUT to the folder the files go back from}
+OUT="$OUT/check" bash tools/gpu_check.sh "$BUNDLE" "$CACHE" --parts contract drag tilt spread \
+    --deadline 330 --tilt-every 50
+first=$?
+[ "$first" -eq 2 ] && exit 2  # no engine here (gpu_check.sh said why): the bench cannot run either
+# the bundle stays unpacked and the compiled kernels stay in /tmp/gpu_check/jit: no cache to give
+OUT="$OUT/bench" bash tools/gpu_check.sh "$BUNDLE" "" --parts bench --rounds 20 --bench-steps 500 \
+    --settle-steps 6000 --cd-freq 20 --deadline 300
+second=$?
+rm -f "$OUT/check/jit-cache.tar.xz" "$OUT/bench/gpu.txt"
+echo "gpu_session: check exit $first, bench exit $second"
+exit $(( first > second ? first : second ))
