@@ -166,8 +166,9 @@ class _BenchSolver:
 
 def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     """The bench, on a stand-in engine: both models alternated each round; with --cd-freq the
-    pair again with detection every N steps for both (adaptive scheduling off); the engine's
-    printed statistics read back as numbers and shown in the summary."""
+    pair again with detection every N steps for both (adaptive scheduling off); with --control
+    the engine's model in two solvers (adaptive); the engine's printed statistics read back as
+    numbers and shown in the summary."""
     from stickslip.adapters import deme as adapter
 
     fake = type("FakeDeme", (), {"DEMSolver": _BenchSolver})
@@ -177,10 +178,15 @@ def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     work.mkdir()
     args = check.main.__globals__["argparse"].Namespace(
         work=str(work), parts=["bench"], bench_grid=2, rounds=3, bench_steps=10, settle_steps=5, cd_freq=20,
-        t0=check.time.time(), deadline=60.0)
+        control=True, t0=check.time.time(), deadline=60.0)
     _BenchSolver.log = []
     out = check.run_bench(args, lambda msg: None)
-    assert len(out["ratios"]) == 3 and len(out["fixed_cd"]["ratios"]) == 3
+    assert len(out["ratios"]) == 3 and len(out["fixed_cd"]["ratios"]) == 3 and len(out["control"]["ratios"]) == 3
+    # the control's two solvers are both the engine's model, detection adaptive; the pairs'
+    # first solvers are the force model (attach, stubbed here: no engine model called)
+    stock = {i for i, name, a in _BenchSolver.log if name == "UseFrictionalHertzianModel"}
+    assert len(stock) == 4 and out["control"]["pair"] == ["stock_a", "stock_b"]
+    assert out["control"]["update_freq"]["stock_b"] == [37.5] * 3
     assert out["engine_stats"]["stock"]["Number of updates kinematic gets"] == 400
     assert out["engine_stats"]["stickslip"]["dT: Calculate contact forces"] == 5.5
     assert out["engine_stats"]["stock"]["kT: kT total active time"] == 1.5
@@ -190,4 +196,6 @@ def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     (work / "bench.json").write_text(json.dumps({**out, "ok": True}, default=str))
     text = check.summary(args, 100.0)
     assert "contact detection: adaptive" in text and "contact detection: 20" in text
+    assert "stick-slip / stock per round" in text and "stock (a) / stock (b) per round" in text
+    assert "A/A control" in text
     assert "Number of updates kinematic gets 400" in text and "dT: Calculate contact forces 5.5" in text

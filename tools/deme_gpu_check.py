@@ -10,7 +10,8 @@
              with bounds derived for float and the engine's start (see BOUNDS)
   bench      a bed of >= 500 000 spheres settling in a box: the stick-slip model (Hertz-Mindlin
              normal force) and the engine's own frictional Hertz-Mindlin, same bed, same
-             steps, alternated in one process; the ratio per round and its spread
+             steps, alternated in one process; the ratio per round and its spread (with
+             --control also the engine's model against itself in two solvers: an A/A pair)
   spread     pyref's tilt with float-sized changes of its inputs: how far the final speed
              moves (the tilt's bound, BOUNDS)
 
@@ -527,62 +528,63 @@ def engine_stats(text):
     return stats
 
 
-def _bench_pair(args, deme, log, cd_freq, wait):
-    """The two models on the same bed: initialise, settle, then `rounds` blocks of each,
-    alternated; block times, contacts, the engine's update frequency after each block and its
-    own statistics over the rounds."""
+# The bench's pairs of solvers: (label, kind) of the model timed, then of the one it is
+# divided by. CONTROL is an A/A pair: the engine's model against itself in a second solver,
+# so that its ratios' spread is what the engine's own scheduling gives two equal solvers.
+PAIR = (("stickslip", "stickslip"), ("stock", "stock"))
+CONTROL = (("stock_a", "stock"), ("stock_b", "stock"))
+SHOWN = {"stickslip": "stick-slip", "stock": "stock", "stock_a": "stock (a)", "stock_b": "stock (b)"}
+
+
+def _bench_pair(args, deme, log, cd_freq, wait, pair=PAIR):
+    """The two solvers of `pair` on the same bed: initialise, settle, then `rounds` blocks of
+    each, alternated; block times, contacts, the engine's update frequency after each block and
+    its own statistics over the rounds. The ratio is the first's time over the second's."""
     from stickslip.adapters import deme as adapter
     from stickslip.bench.ratio_interval import ratio_interval
     import statistics
 
     dt, steps = 2e-6, args.bench_steps
+    (a, kind_a), (b, kind_b) = pair
     out = {"spheres": args.bench_grid ** 3, "dt": dt, "steps_per_block": steps, "settle_steps": args.settle_steps,
-           "cd_freq": cd_freq or "adaptive"}
-    ss_solver, n = bench_solver(deme, "stickslip", args.bench_grid, dt, cd_freq)
-    t0 = time.perf_counter()
-    ss_solver.Initialize()
-    out["init_stickslip_s"] = time.perf_counter() - t0
-    log(f"bench ({out['cd_freq']}): stick-slip initialised in {out['init_stickslip_s']:.0f} s")
-    # (the stock model's compile, warm_stock, runs beside this one's: wait for it, but leave
-    # time for a cold compile here and the rounds)
-    if "warm_stock" in args.parts:
-        wait_json(Path(args.work) / "warm_stock.json", args.t0 + args.deadline - 200 - time.time())
-    out["stock_cache_warmed"] = (Path(args.work) / "warm_stock.json").is_file()
-    stock, _ = bench_solver(deme, "stock", args.bench_grid, dt, cd_freq)
-    t0 = time.perf_counter()
-    stock.Initialize()
-    out["init_stock_s"] = time.perf_counter() - t0
-    log(f"bench ({out['cd_freq']}): stock initialised in {out['init_stock_s']:.0f} s")
-    solvers = {"stickslip": ss_solver, "stock": stock}
-    for name, s in solvers.items():  # settle (the bed falls the 1 % gaps and starts its contacts)
+           "cd_freq": cd_freq or "adaptive", "pair": [a, b], "init_s": {}}
+    solvers = {}
+    for label, kind in pair:
+        if kind == "stock" and "warm_stock" in args.parts and "stock_cache_warmed" not in out:
+            # (the stock model's compile, warm_stock, runs beside the first's: wait for it, but
+            # leave time for a cold compile here and the rounds)
+            wait_json(Path(args.work) / "warm_stock.json", args.t0 + args.deadline - 200 - time.time())
+        out.setdefault("stock_cache_warmed", (Path(args.work) / "warm_stock.json").is_file())
+        solvers[label], _ = bench_solver(deme, kind, args.bench_grid, dt, cd_freq)
+        t0 = time.perf_counter()
+        solvers[label].Initialize()
+        out["init_s"][label] = time.perf_counter() - t0
+        log(f"bench ({out['cd_freq']}): {SHOWN[label]} initialised in {out['init_s'][label]:.0f} s")
+    for s in solvers.values():  # settle (the bed falls the 1 % gaps and starts its contacts)
         s.DoDynamicsThenSync(adapter.steps_duration(args.settle_steps, dt))
     out["gpu_to_itself"] = wait()
     for s in solvers.values():
         s.ClearTimingStats()
         s.ClearThreadCollaborationStats()
-    times = {"stickslip": [], "stock": []}
-    contacts = {"stickslip": [], "stock": []}
-    freq = {"stickslip": [], "stock": []}
+    times, contacts, freq = ({a: [], b: []} for _ in range(3))
     for rnd in range(args.rounds):
-        order = ("stickslip", "stock") if rnd % 2 == 0 else ("stock", "stickslip")
-        for name in order:
-            s = solvers[name]
+        for label in ((a, b) if rnd % 2 == 0 else (b, a)):
+            s = solvers[label]
             t0 = time.perf_counter()
             s.DoDynamicsThenSync(adapter.steps_duration(steps, dt))
-            times[name].append(time.perf_counter() - t0)
-            contacts[name].append(int(s.GetNumContacts()))
-            freq[name].append(float(s.GetUpdateFreq()))
-        log(f"bench ({out['cd_freq']}): round {rnd + 1}: stick-slip {times['stickslip'][-1]:.3f} s, "
-            f"stock {times['stock'][-1]:.3f} s")
+            times[label].append(time.perf_counter() - t0)
+            contacts[label].append(int(s.GetNumContacts()))
+            freq[label].append(float(s.GetUpdateFreq()))
+        log(f"bench ({out['cd_freq']}): round {rnd + 1}: {SHOWN[a]} {times[a][-1]:.3f} s, "
+            f"{SHOWN[b]} {times[b][-1]:.3f} s")
     out["engine_stats"], out["engine_text"] = {}, {}
-    for name, s in solvers.items():
+    for label, s in solvers.items():
         text = printed(lambda: (s.ShowThreadCollaborationStats(), s.ShowTimingStats()))
-        out["engine_text"][name], out["engine_stats"][name] = text, engine_stats(text)
-    ratios = [a / b for a, b in zip(times["stickslip"], times["stock"])]
+        out["engine_text"][label], out["engine_stats"][label] = text, engine_stats(text)
+    ratios = [x / y for x, y in zip(times[a], times[b])]
     # the geometric mean of the rounds' ratios and its 95 % interval over rounds (the CPU
     # engines' benchmarks do the same: stickslip/bench/ratio_interval.py)
-    out["ratio_geomean"], out["ratio_low"], out["ratio_high"] = ratio_interval(
-        list(zip(times["stock"], times["stickslip"])))
+    out["ratio_geomean"], out["ratio_low"], out["ratio_high"] = ratio_interval(list(zip(times[b], times[a])))
     out.update(times=times, contacts=contacts, update_freq=freq, ratios=ratios, ratio_mean=statistics.mean(ratios),
                ratio_min=min(ratios), ratio_max=max(ratios),
                ms_per_step={k: [1e3 * t / steps for t in v] for k, v in times.items()})
@@ -591,17 +593,22 @@ def _bench_pair(args, deme, log, cd_freq, wait):
 
 def run_bench(args, log):
     """The bench with the engine's scheduling of contact detection, then (--cd-freq N) with
-    detection every N steps for both models, one pair of solvers after the other."""
+    detection every N steps for both models, then (--control) the A/A pair with the engine's
+    scheduling, one pair of solvers after the other."""
     import gc
     from stickslip.adapters import deme as adapter
 
     deme = adapter._import_deme()
     others = [p for p in GPU_PARTS if p in args.parts]
+    pairs = 1 + (args.cd_freq > 0) + args.control
     out = _bench_pair(args, deme, log, 0, lambda: wait_parts(
-        args, others, args.t0 + args.deadline - 30 - 8 * args.rounds * (2 if args.cd_freq else 1) - time.time()))
+        args, others, args.t0 + args.deadline - 30 - 8 * args.rounds * pairs - time.time()))
     if args.cd_freq > 0:
         gc.collect()
         out["fixed_cd"] = _bench_pair(args, deme, log, args.cd_freq, lambda: wait_parts(args, others, 0))
+    if args.control:
+        gc.collect()
+        out["control"] = _bench_pair(args, deme, log, 0, lambda: wait_parts(args, others, 0), pair=CONTROL)
     return out
 
 
@@ -673,7 +680,7 @@ def orchestrate(args):
         cmd = [sys.executable, __file__, "--part", part, "--work", str(out), "--deadline", str(args.deadline),
                "--bench-grid", str(args.bench_grid), "--rounds", str(args.rounds), "--t0", repr(t_start),
                "--tilt-every", str(args.tilt_every), "--bench-steps", str(args.bench_steps),
-               "--settle-steps", str(args.settle_steps), "--cd-freq", str(args.cd_freq), "--parts", *args.parts]
+               "--settle-steps", str(args.settle_steps), "--cd-freq", str(args.cd_freq), *(["--control"] if args.control else []), "--parts", *args.parts]
         procs[part] = (subprocess.Popen(cmd, stdout=logf, stderr=subprocess.STDOUT, env=env), logf)
         print(f"started {part}", flush=True)
     pending = set(procs)
@@ -746,8 +753,9 @@ def summary(args, elapsed):
     b = res.get("bench")
     if b and b.get("ok"):
         lines += bench_lines(b)
-        if b.get("fixed_cd"):
-            lines += bench_lines(b["fixed_cd"])
+        for more in ("fixed_cd", "control"):
+            if b.get(more):
+                lines += bench_lines(b[more])
     elif "bench" in res:
         lines.append(f"bench: {'no result' if not b else b.get('error')}")
     w = res.get("warm_stock")
@@ -763,23 +771,29 @@ STATS_SHOWN = ("Number of updates kinematic gets", "Average steps per dynamic up
 
 def bench_lines(b):
     """The summary's lines for one pair of bench solvers."""
+    a, c = b["pair"]
+    na, nc = SHOWN[a], SHOWN[c]
     lines = [f"bench (contact detection: {b.get('cd_freq', 'adaptive')}): {b['spheres']} spheres, "
-             f"{b['steps_per_block']} steps a block, dt {b['dt']:g}; initialise stick-slip "
-             f"{b['init_stickslip_s']:.0f} s, stock {b['init_stock_s']:.0f} s (cache warmed by the other "
-             f"process: {b['stock_cache_warmed']}); GPU to itself: {b['gpu_to_itself']}",
-             f"  ms per step: stick-slip {', '.join(f'{v:.3f}' for v in b['ms_per_step']['stickslip'])}; "
-             f"stock {', '.join(f'{v:.3f}' for v in b['ms_per_step']['stock'])}",
-             f"  contacts: stick-slip {b['contacts']['stickslip']}, stock {b['contacts']['stock']}"]
+             f"{b['steps_per_block']} steps a block, dt {b['dt']:g}; initialise "
+             + ", ".join(f"{SHOWN[k]} {v:.0f} s" for k, v in b["init_s"].items())
+             + f" (stock's cache warmed by the other process: {b['stock_cache_warmed']}); "
+             f"GPU to itself: {b['gpu_to_itself']}",
+             f"  ms per step: {na} {', '.join(f'{v:.3f}' for v in b['ms_per_step'][a])}; "
+             f"{nc} {', '.join(f'{v:.3f}' for v in b['ms_per_step'][c])}",
+             f"  contacts: {na} {b['contacts'][a]}, {nc} {b['contacts'][c]}"]
     if b.get("update_freq"):
-        lines.append(f"  engine's update frequency after each block: stick-slip {b['update_freq']['stickslip']}, "
-                     f"stock {b['update_freq']['stock']}")
-    for name, st in (b.get("engine_stats") or {}).items():
+        lines.append(f"  engine's update frequency after each block: {na} {b['update_freq'][a]}, "
+                     f"{nc} {b['update_freq'][c]}")
+    for label, st in (b.get("engine_stats") or {}).items():
         shown = [f"{k} {st[k]:.4g}" for k in STATS_SHOWN if k in st]
-        lines.append(f"  engine's own statistics over the rounds, {name}: " + ("; ".join(shown) or "none printed"))
-    lines.append(f"  stick-slip / stock per round: {', '.join(f'{r:.3f}' for r in b['ratios'])}; mean "
+        lines.append(f"  engine's own statistics over the rounds, {SHOWN[label]}: "
+                     + ("; ".join(shown) or "none printed"))
+    what = ("target <= 1.05" if [a, c] == [p[0] for p in PAIR]
+            else "A/A control: the same model in two solvers, 1 but for the engine's own scheduling")
+    lines.append(f"  {na} / {nc} per round: {', '.join(f'{r:.3f}' for r in b['ratios'])}; mean "
                  f"{b['ratio_mean']:.3f}, range {b['ratio_min']:.3f}-{b['ratio_max']:.3f}; geometric mean "
                  f"{b['ratio_geomean']:.3f} (95 % over rounds {b['ratio_low']:.3f}-{b['ratio_high']:.3f}; "
-                 f"target <= 1.05)")
+                 f"{what})")
     return lines
 
 
@@ -801,6 +815,8 @@ def main(argv=None):
     ap.add_argument("--tilt-every", type=int, default=25, help="the tilt's rows, in steps (default 25)")
     ap.add_argument("--cd-freq", type=int, default=0,
                     help="N > 0: the bench again with contact detection every N steps for both models")
+    ap.add_argument("--control", action="store_true",
+                    help="the bench's A/A control too: the engine's model against itself in a second solver")
     args = ap.parse_args(argv)
     Path(args.work).mkdir(parents=True, exist_ok=True)
     if args.t0 is None:

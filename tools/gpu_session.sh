@@ -8,9 +8,10 @@
 # 1. $OUT/check: the contract rows, drag, tilt and the tilt's spread (tools/gpu_check.sh),
 #    their solvers compiling side by side: ~160-330 s when the force model changed since
 #    JIT_CACHE was made, seconds of compiling when it did not.
-# 2. $OUT/bench: the bench with the GPU to itself (20 rounds of 500 steps, adaptive detection
-#    and every 20 steps): ~90 s on a warm cache, plus up to ~160 s for a cold compile of the
-#    stick-slip model's bench kernels (the kernels of step 1 are other ones).
+# 2. $OUT/bench: the bench with the GPU to itself (20 rounds of 500 steps: adaptive detection,
+#    every 20 steps, and the A/A control of the engine's model against itself): ~125 s on a
+#    warm cache, plus up to ~160 s for a cold compile of the stick-slip model's bench kernels
+#    (the kernels of step 1 are other ones).
 # Keeps 8 files: each step's summary.txt, results.json and parts.log, the first gpu.txt and
 # the last jit-cache.tar.xz (which holds both steps' kernels: put it in .gpu for the next run).
 set -uo pipefail
@@ -24,7 +25,7 @@ first=$?
 [ "$first" -eq 2 ] && exit 2  # no engine here (gpu_check.sh said why): the bench cannot run either
 # the bundle stays unpacked and the compiled kernels stay in /tmp/gpu_check/jit: no cache to give
 OUT="$OUT/bench" bash tools/gpu_check.sh "$BUNDLE" "" --parts bench --rounds 20 --bench-steps 500 \
-    --settle-steps 6000 --cd-freq 20 --deadline 300
+    --settle-steps 6000 --cd-freq 20 --control --deadline 330
 second=$?
 rm -f "$OUT/check/jit-cache.tar.xz" "$OUT/bench/gpu.txt"
 echo "gpu_session: check exit $first, bench exit $second"
