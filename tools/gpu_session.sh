@@ -6,7 +6,7 @@
 #   OUT=$OUT bash tools/gpu_session.sh BUNDLE [JIT_CACHE]     (carry: .gpu and build/deme_shim)
 #
 # 1. $OUT/check: the contract rows, drag, tilt and the tilt's spread (tools/gpu_check.sh),
-#    their solvers compiling side by side: ~160-330 s when the force model changed since
+#    their solvers compiling side by side: ~160-280 s when the force model changed since
 #    JIT_CACHE was made, seconds of compiling when it did not.
 # 2. $OUT/bench: the bench with the GPU to itself (20 rounds of 500 steps: adaptive detection,
 #    every 20 steps, and the A/A control of the engine's model against itself): ~125 s on a
@@ -20,12 +20,12 @@ BUNDLE=${1:?usage: OUT=DIR bash tools/gpu_session.sh BUNDLE [JIT_CACHE]}
 CACHE=${2:-}
 OUT=${OUT:?set OUT to the folder the files go back from}
 OUT="$OUT/check" bash tools/gpu_check.sh "$BUNDLE" "$CACHE" --parts contract drag tilt spread \
-    --deadline 330 --tilt-every 50
+    --deadline 280 --tilt-every 50
 first=$?
 [ "$first" -eq 2 ] && exit 2  # no engine here (gpu_check.sh said why): the bench cannot run either
 # the bundle stays unpacked and the compiled kernels stay in /tmp/gpu_check/jit: no cache to give
 OUT="$OUT/bench" bash tools/gpu_check.sh "$BUNDLE" "" --parts bench --rounds 20 --bench-steps 500 \
-    --settle-steps 6000 --cd-freq 20 --control --deadline 330
+    --settle-steps 6000 --cd-freq 20 --control --deadline 290
 second=$?
 rm -f "$OUT/check/jit-cache.tar.xz" "$OUT/bench/gpu.txt"
 echo "gpu_session: check exit $first, bench exit $second"
