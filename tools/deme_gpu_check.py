@@ -545,7 +545,7 @@ def _bench_pair(args, deme, log, cd_freq, wait, pair=PAIR):
     import statistics
 
     dt, steps = 2e-6, args.bench_steps
-    (a, kind_a), (b, kind_b) = pair
+    (a, _), (b, _) = pair
     out = {"spheres": args.bench_grid ** 3, "dt": dt, "steps_per_block": steps, "settle_steps": args.settle_steps,
            "cd_freq": cd_freq or "adaptive", "pair": [a, b], "init_s": {}}
     solvers = {}
@@ -680,7 +680,8 @@ def orchestrate(args):
         cmd = [sys.executable, __file__, "--part", part, "--work", str(out), "--deadline", str(args.deadline),
                "--bench-grid", str(args.bench_grid), "--rounds", str(args.rounds), "--t0", repr(t_start),
                "--tilt-every", str(args.tilt_every), "--bench-steps", str(args.bench_steps),
-               "--settle-steps", str(args.settle_steps), "--cd-freq", str(args.cd_freq), *(["--control"] if args.control else []), "--parts", *args.parts]
+               "--settle-steps", str(args.settle_steps), "--cd-freq", str(args.cd_freq),
+               *(["--control"] if args.control else []), "--parts", *args.parts]
         procs[part] = (subprocess.Popen(cmd, stdout=logf, stderr=subprocess.STDOUT, env=env), logf)
         print(f"started {part}", flush=True)
     pending = set(procs)

@@ -12,8 +12,10 @@
 #    every 20 steps, and the A/A control of the engine's model against itself): ~125 s on a
 #    warm cache, plus up to ~160 s for a cold compile of the stick-slip model's bench kernels
 #    (the kernels of step 1 are other ones).
-# Keeps 8 files: each step's summary.txt, results.json and parts.log, the first gpu.txt and
-# the last jit-cache.tar.xz (which holds both steps' kernels: put it in .gpu for the next run).
+# Keeps 8 files (the device machine sends back no more): each step's summary.txt and
+# results.json, the drag's and tilt's time series (check/*_deme.csv.gz), logs.txt (the GPU's
+# name and both steps' parts.log) and the last jit-cache.tar.xz (which holds both steps'
+# kernels: put it in .gpu for the next run).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 BUNDLE=${1:?usage: OUT=DIR bash tools/gpu_session.sh BUNDLE [JIT_CACHE]}
@@ -27,6 +29,8 @@ first=$?
 OUT="$OUT/bench" bash tools/gpu_check.sh "$BUNDLE" "" --parts bench --rounds 20 --bench-steps 500 \
     --settle-steps 6000 --cd-freq 20 --control --deadline 290
 second=$?
-rm -f "$OUT/check/jit-cache.tar.xz" "$OUT/bench/gpu.txt"
+cat "$OUT/check/gpu.txt" "$OUT/check/parts.log" "$OUT/bench/parts.log" > "$OUT/logs.txt" 2>/dev/null
+rm -f "$OUT/check/jit-cache.tar.xz" "$OUT"/{check,bench}/{gpu.txt,parts.log}
+ls -la "$OUT" "$OUT/check" "$OUT/bench"
 echo "gpu_session: check exit $first, bench exit $second"
 exit $(( first > second ? first : second ))
