@@ -146,8 +146,8 @@ class _BenchSolver:
             _BenchSolver.log.append((id(self), name, args))
             if name == "SetCDUpdateFreq":
                 self.freq = args[0]
-            return 1523200 if name == "GetNumContacts" else (float(self.freq or 37.5) if name == "GetUpdateFreq"
-                                                              else None)
+            return {"GetNumContacts": 1523200, "GetUpdateFreq": float(self.freq or 37.5),
+                    "GetBinSize": 4.25e-3}.get(name)
         return call
 
     def ShowThreadCollaborationStats(self):
@@ -186,7 +186,7 @@ def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     # first solvers are the force model (attach, stubbed here: no engine model called)
     stock = {i for i, name, a in _BenchSolver.log if name == "UseFrictionalHertzianModel"}
     assert len(stock) == 4 and out["control"]["pair"] == ["stock_a", "stock_b"]
-    assert out["control"]["update_freq"]["stock_b"] == [37.5] * 3
+    assert out["control"]["update_freq"]["stock_b"] == [37.5] * 3 and out["bin_size"]["stickslip"] == [4.25e-3] * 3
     assert out["engine_stats"]["stock"]["Number of updates kinematic gets"] == 400
     assert out["engine_stats"]["stickslip"]["dT: Calculate contact forces"] == 5.5
     assert out["engine_stats"]["stock"]["kT: kT total active time"] == 1.5
@@ -197,5 +197,5 @@ def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     text = check.summary(args, 100.0)
     assert "contact detection: adaptive" in text and "contact detection: 20" in text
     assert "stick-slip / stock per round" in text and "stock (a) / stock (b) per round" in text
-    assert "A/A control" in text
+    assert "A/A control" in text and "bin size after each block (m): stick-slip 0.00425, 0.00425" in text
     assert "Number of updates kinematic gets 400" in text and "dT: Calculate contact forces 5.5" in text

@@ -566,7 +566,7 @@ def _bench_pair(args, deme, log, cd_freq, wait, pair=PAIR):
     for s in solvers.values():
         s.ClearTimingStats()
         s.ClearThreadCollaborationStats()
-    times, contacts, freq = ({a: [], b: []} for _ in range(3))
+    times, contacts, freq, bins = ({a: [], b: []} for _ in range(4))
     for rnd in range(args.rounds):
         for label in ((a, b) if rnd % 2 == 0 else (b, a)):
             s = solvers[label]
@@ -575,6 +575,9 @@ def _bench_pair(args, deme, log, cd_freq, wait, pair=PAIR):
             times[label].append(time.perf_counter() - t0)
             contacts[label].append(int(s.GetNumContacts()))
             freq[label].append(float(s.GetUpdateFreq()))
+            # (its adaptive bin size, on unless disabled, hill-climbs on detection's wall time
+            # from a random start: one of the states that can set a solver's cost apart)
+            bins[label].append(float(s.GetBinSize()))
         log(f"bench ({out['cd_freq']}): round {rnd + 1}: {SHOWN[a]} {times[a][-1]:.3f} s, "
             f"{SHOWN[b]} {times[b][-1]:.3f} s")
     out["engine_stats"], out["engine_text"] = {}, {}
@@ -585,8 +588,8 @@ def _bench_pair(args, deme, log, cd_freq, wait, pair=PAIR):
     # the geometric mean of the rounds' ratios and its 95 % interval over rounds (the CPU
     # engines' benchmarks do the same: stickslip/bench/ratio_interval.py)
     out["ratio_geomean"], out["ratio_low"], out["ratio_high"] = ratio_interval(list(zip(times[b], times[a])))
-    out.update(times=times, contacts=contacts, update_freq=freq, ratios=ratios, ratio_mean=statistics.mean(ratios),
-               ratio_min=min(ratios), ratio_max=max(ratios),
+    out.update(times=times, contacts=contacts, update_freq=freq, bin_size=bins, ratios=ratios,
+               ratio_mean=statistics.mean(ratios), ratio_min=min(ratios), ratio_max=max(ratios),
                ms_per_step={k: [1e3 * t / steps for t in v] for k, v in times.items()})
     return out
 
@@ -766,6 +769,7 @@ def summary(args, elapsed):
 
 
 STATS_SHOWN = ("Number of updates kinematic gets", "Average steps per dynamic update",
+               "Average steps contact detection lags behind",
                "Number of times dynamic held back", "kT total active time", "dT total active time",
                "dT: Calculate contact forces", "dT: Wait for kT update", "dT: Integration")
 
@@ -785,6 +789,9 @@ def bench_lines(b):
     if b.get("update_freq"):
         lines.append(f"  engine's update frequency after each block: {na} {b['update_freq'][a]}, "
                      f"{nc} {b['update_freq'][c]}")
+    if b.get("bin_size"):
+        sizes = {k: ", ".join(f"{v:.4g}" for v in b["bin_size"][k]) for k in (a, c)}
+        lines.append(f"  engine's bin size after each block (m): {na} {sizes[a]}; {nc} {sizes[c]}")
     for label, st in (b.get("engine_stats") or {}).items():
         shown = [f"{k} {st[k]:.4g}" for k in STATS_SHOWN if k in st]
         lines.append(f"  engine's own statistics over the rounds, {SHOWN[label]}: "
