@@ -112,12 +112,15 @@ case "${1:-}" in
     test)
         setup
         shift
-        # pytest-xdist workers, two per core (STICKSLIP_TEST_JOBS=N: N workers, 0: this process):
-        # many tests wait on engine processes (MPI start-up, YADE's import, a shared run another
-        # worker is making), and a second worker per core fills those waits (docs/testing.md,
-        # History: 2 workers 364-376 s, 3 312 s, 4 292 s). Tests are independent, and the runs
-        # several tests read are made once (tests/conftest.py).
-        .venv/bin/python -m pytest -q -n "${STICKSLIP_TEST_JOBS:-$((2 * $(nproc)))}" --dist worksteal "$@"
+        # pytest-xdist workers, two per core and at most 16 (STICKSLIP_TEST_JOBS=N: N workers, 0:
+        # this process): many tests wait on engine processes (MPI start-up, YADE's import, a
+        # shared run another worker is making), and a second worker per core fills those waits
+        # (docs/testing.md, History: 2 workers 340-376 s, 3 312 s, 4 292-308 s on 2 cores); past
+        # 16 the longest test (~45 s) sets the time, and each worker costs memory. Tests are
+        # independent, and the runs several tests read are made once (tests/conftest.py).
+        workers=$((2 * $(nproc)))
+        [ "$workers" -gt 16 ] && workers=16
+        .venv/bin/python -m pytest -q -n "${STICKSLIP_TEST_JOBS:-$workers}" --dist worksteal "$@"
         ;;
     setup)
         setup
