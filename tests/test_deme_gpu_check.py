@@ -167,8 +167,9 @@ class _BenchSolver:
 def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     """The bench, on a stand-in engine: both models alternated each round; with --cd-freq the
     pair again with detection every N steps for both (adaptive scheduling off); with --control
-    the engine's model in two solvers (adaptive); the engine's printed statistics read back as
-    numbers and shown in the summary."""
+    the engine's model in two solvers (adaptive); each pair's first stock solver waits for
+    warm_stock's compile; the engine's printed statistics read back as numbers and shown in
+    the summary."""
     from stickslip.adapters import deme as adapter
 
     fake = type("FakeDeme", (), {"DEMSolver": _BenchSolver})
@@ -177,10 +178,15 @@ def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     work = tmp_path / "w"
     work.mkdir()
     args = check.main.__globals__["argparse"].Namespace(
-        work=str(work), parts=["bench"], bench_grid=2, rounds=3, bench_steps=10, settle_steps=5, cd_freq=20,
-        control=True, t0=check.time.time(), deadline=60.0)
+        work=str(work), parts=["bench", "warm_stock"], bench_grid=2, rounds=3, bench_steps=10, settle_steps=5,
+        cd_freq=20, control=True, t0=check.time.time(), deadline=60.0)
     _BenchSolver.log = []
+    monkeypatch.setattr(check, "wait_json", lambda path, timeout: _BenchSolver.log.append((None, "wait", path.name)))
     out = check.run_bench(args, lambda msg: None)
+    # each pair waits once for warm_stock, before its first stock solver is made
+    calls = [(name, a) for i, name, a in _BenchSolver.log if name in ("wait", "UseFrictionalHertzianModel")]
+    assert calls == [("wait", "warm_stock.json"), ("UseFrictionalHertzianModel", ())] * 3 \
+        + [("UseFrictionalHertzianModel", ())], calls
     assert len(out["ratios"]) == 3 and len(out["fixed_cd"]["ratios"]) == 3 and len(out["control"]["ratios"]) == 3
     # the control's two solvers are both the engine's model, detection adaptive; the pairs'
     # first solvers are the force model (attach, stubbed here: no engine model called)

@@ -550,11 +550,12 @@ def _bench_pair(args, deme, log, cd_freq, wait, pair=PAIR):
            "cd_freq": cd_freq or "adaptive", "pair": [a, b], "init_s": {}}
     solvers = {}
     for label, kind in pair:
-        if kind == "stock" and "warm_stock" in args.parts and "stock_cache_warmed" not in out:
-            # (the stock model's compile, warm_stock, runs beside the first's: wait for it, but
-            # leave time for a cold compile here and the rounds)
-            wait_json(Path(args.work) / "warm_stock.json", args.t0 + args.deadline - 200 - time.time())
-        out.setdefault("stock_cache_warmed", (Path(args.work) / "warm_stock.json").is_file())
+        if kind == "stock" and "stock_cache_warmed" not in out:  # the pair's first stock solver
+            if "warm_stock" in args.parts:
+                # (the stock model's compile, warm_stock, runs beside the first's: wait for it,
+                # but leave time for a cold compile here and the rounds)
+                wait_json(Path(args.work) / "warm_stock.json", args.t0 + args.deadline - 200 - time.time())
+            out["stock_cache_warmed"] = (Path(args.work) / "warm_stock.json").is_file()
         solvers[label], _ = bench_solver(deme, kind, args.bench_grid, dt, cd_freq)
         t0 = time.perf_counter()
         solvers[label].Initialize()
