@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# A whole GPU check in one call of the device machine (one command of at most 600 s, at most
-# 8 files back; a warm machine is given back after ~30 s idle, so a second call would start a
-# fresh one):
+# The whole GPU check in one command on a lent GPU machine, which runs one command of at most
+# 600 s, sends back at most 8 files, and is given back after ~30 s idle (a second command
+# would start a fresh one):
 #
-#   OUT=$OUT bash tools/gpu_session.sh BUNDLE [JIT_CACHE]     (carry: .gpu and build/deme_shim)
+#   OUT=$OUT bash tools/gpu_check_all.sh BUNDLE [JIT_CACHE]     (carry: .gpu and build/deme_shim)
 #
 # 1. $OUT/check: the contract rows, drag, tilt and the tilt's spread (tools/gpu_check.sh),
 #    their solvers compiling side by side: ~160-280 s when the force model changed since
@@ -18,7 +18,7 @@
 # kernels: put it in .gpu for the next run).
 set -uo pipefail
 cd "$(dirname "$0")/.."
-BUNDLE=${1:?usage: OUT=DIR bash tools/gpu_session.sh BUNDLE [JIT_CACHE]}
+BUNDLE=${1:?usage: OUT=DIR bash tools/gpu_check_all.sh BUNDLE [JIT_CACHE]}
 CACHE=${2:-}
 OUT=${OUT:?set OUT to the folder the files go back from}
 OUT="$OUT/check" bash tools/gpu_check.sh "$BUNDLE" "$CACHE" --parts contract drag tilt spread \
@@ -32,5 +32,5 @@ second=$?
 cat "$OUT/check/gpu.txt" "$OUT/check/parts.log" "$OUT/bench/parts.log" > "$OUT/logs.txt" 2>/dev/null
 rm -f "$OUT/check/jit-cache.tar.xz" "$OUT"/{check,bench}/{gpu.txt,parts.log}
 ls -la "$OUT" "$OUT/check" "$OUT/bench"
-echo "gpu_session: check exit $first, bench exit $second"
+echo "gpu_check_all: check exit $first, bench exit $second"
 exit $(( first > second ? first : second ))
