@@ -166,7 +166,8 @@ class _BenchSolver:
 
 def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     """The bench, on a stand-in engine: both models alternated each round; with --cd-freq the
-    pair again with detection every N steps for both (adaptive scheduling off); with --control
+    pair again with detection every N steps and a fixed bin size for both (adaptive
+    scheduling off); with --control
     the engine's model in two solvers (adaptive); each pair's first stock solver waits for
     warm_stock's compile; the engine's printed statistics read back as numbers and shown in
     the summary."""
@@ -199,6 +200,7 @@ def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     assert out["update_freq"]["stock"] == [37.5] * 3 and out["fixed_cd"]["update_freq"]["stock"] == [20.0] * 3
     fixed = {i for i, name, a in _BenchSolver.log if name == "DisableAdaptiveUpdateFreq"}
     assert len(fixed) == 2 and all((i, "SetCDUpdateFreq", (20,)) in _BenchSolver.log for i in fixed)
+    assert fixed == {i for i, name, a in _BenchSolver.log if name == "DisableAdaptiveBinSize"}
     (work / "bench.json").write_text(json.dumps({**out, "ok": True}, default=str))
     text = check.summary(args, 100.0)
     assert "contact detection: adaptive" in text and "contact detection: 20" in text

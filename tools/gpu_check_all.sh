@@ -9,9 +9,9 @@
 #    their solvers compiling side by side: ~160-280 s when the force model changed since
 #    JIT_CACHE was made, seconds of compiling when it did not.
 # 2. $OUT/bench: the bench with the GPU to itself (20 rounds of 500 steps: adaptive detection,
-#    every 20 steps, and the A/A control of the engine's model against itself): ~125 s on a
-#    warm cache, plus up to ~160 s for a cold compile of the stick-slip model's bench kernels
-#    (the kernels of step 1 are other ones).
+#    every 20 steps with a fixed bin size, and the A/A control of the engine's model against
+#    itself): ~125 s on a warm cache, plus up to ~160 s for a cold compile of the stick-slip
+#    model's bench kernels (the kernels of step 1 are other ones).
 # Keeps 8 files (the device machine sends back no more): each step's summary.txt and
 # results.json, the drag's and tilt's time series (check/*_deme.csv.gz), logs.txt (the GPU's
 # name and both steps' parts.log) and the last jit-cache.tar.xz (which holds both steps'
