@@ -207,3 +207,31 @@ def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     assert "stick-slip / stock per round" in text and "stock (a) / stock (b) per round" in text
     assert "A/A control" in text and "bin size after each block (m): stick-slip 0.00425, 0.00425" in text
     assert "Number of updates kinematic gets 400" in text and "dT: Calculate contact forces 5.5" in text
+
+
+def test_the_pages_gpu_figure_is_made_from_the_stored_series(tmp_path):
+    """tools/deme_gpu_figure.py draws deme_model/README.md's picture from the GPU check's time
+    series kept in deme_model/measured/, and the page's figures are those series': the drag's
+    slips on pyref's steps, the tilt's Fn / (W cos beta) between 0.646 and 1.350 (its one event)."""
+    import importlib.util
+
+    import numpy as np
+    import pandas as pd
+
+    from stickslip import scene
+
+    ROOT = Path(__file__).resolve().parents[1]
+    path = ROOT / "tools" / "deme_gpu_figure.py"
+    spec = importlib.util.spec_from_file_location("deme_gpu_figure", path)
+    fig = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(fig)
+    png = fig.main(ROOT / "deme_model" / "measured", tmp_path / "f.png")
+    assert png.stat().st_size > 20_000
+    st = scene.load("tilt")
+    t, ratio = fig.sticking_fn_ratio(st, pd.read_csv(ROOT / "deme_model" / "measured" / "tilt_deme.csv.gz"))
+    assert (round(ratio.min(), 3), round(ratio.max(), 3)) == (0.646, 1.350)
+    assert round(t[-1] + (t[1] - t[0]), 4) == 0.9272  # the first slip's row: the page's 0.9272 s
+    quiet = np.abs(ratio[t < 0.444] - 1)
+    assert quiet.max() < 1.3e-3  # the page's 0.9990-1.0013 before the event
+    page = (ROOT / "deme_model" / "README.md").read_text()
+    assert "tools/deme_gpu_figure.py" in page and "measured/drag_tilt_gpu.png" in page
