@@ -167,10 +167,9 @@ class _BenchSolver:
 def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
     """The bench, on a stand-in engine: both models alternated each round; with --cd-freq the
     pair again with detection every N steps and a fixed bin size for both (adaptive
-    scheduling off); with --control
-    the engine's model in two solvers (adaptive); each pair's first stock solver waits for
-    warm_stock's compile; the engine's printed statistics read back as numbers and shown in
-    the summary."""
+    scheduling off); with --control the engine's model in two solvers (adaptive); each pair's
+    first stock solver waits for warm_stock's compile; the engine's printed statistics read
+    back as numbers and shown in the summary."""
     from stickslip.adapters import deme as adapter
 
     fake = type("FakeDeme", (), {"DEMSolver": _BenchSolver})
@@ -213,22 +212,16 @@ def test_the_pages_gpu_figure_is_made_from_the_stored_series(tmp_path):
     """tools/deme_gpu_figure.py draws deme_model/README.md's picture from the GPU check's time
     series kept in deme_model/measured/, and the page's figures are those series': the drag's
     slips on pyref's steps, the tilt's Fn / (W cos beta) between 0.646 and 1.350 (its one event)."""
-    import importlib.util
-
-    import numpy as np
+    import deme_gpu_figure as fig
     import pandas as pd
 
     from stickslip import scene
 
     ROOT = Path(__file__).resolve().parents[1]
-    path = ROOT / "tools" / "deme_gpu_figure.py"
-    spec = importlib.util.spec_from_file_location("deme_gpu_figure", path)
-    fig = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(fig)
     png = fig.main(ROOT / "deme_model" / "measured", tmp_path / "f.png")
     assert png.stat().st_size > 20_000
     st = scene.load("tilt")
-    t, ratio = fig.sticking_fn_ratio(st, pd.read_csv(ROOT / "deme_model" / "measured" / "tilt_deme.csv.gz"))
+    t, ratio = check.sticking_fn_over_weight(st, pd.read_csv(ROOT / "deme_model" / "measured" / "tilt_deme.csv.gz"))
     assert (round(ratio.min(), 3), round(ratio.max(), 3)) == (0.646, 1.350)
     assert round(t[-1] + (t[1] - t[0]), 4) == 0.9272  # the first slip's row: the page's 0.9272 s
     quiet = np.abs(ratio[t < 0.444] - 1)

@@ -359,10 +359,9 @@ def compare_case(name, args, log):
             "fn": {"deme": fn_spread(sc, df), "emulated": f_e, "pyref": fn_spread(sc, ref)}}
 
 
-def fn_spread(sc, df):
-    """The recorded contact's Fn while it sticks before the first slip (rows 1 on): its first
-    value, least and most, each over the weight's normal share W cos(angle) (the tilt's plate
-    turns): how far the start rings."""
+def sticking_fn_over_weight(sc, df):
+    """The recorded contact's Fn while it sticks before the first slip (rows 1 on), over the
+    weight's normal share W cos(angle) (the tilt's plate turns): (times, ratios)."""
     import numpy as np
 
     c = "-".join(sc.output.contacts[0])
@@ -371,7 +370,12 @@ def fn_spread(sc, df):
     end = first[0] if len(first) else len(fn)
     angle = df[f"{sc.output.walls[0]}_angle"].to_numpy() if sc.output.walls else np.zeros(len(fn))
     w = sc.grain_mass(sc.grains[0]) * 9.81 * np.cos(angle)
-    rel = (fn / w)[1:end]
+    return df["t"].to_numpy()[1:end], (fn / w)[1:end]
+
+
+def fn_spread(sc, df):
+    """sticking_fn_over_weight's first value, least and most: how far the start rings."""
+    _, rel = sticking_fn_over_weight(sc, df)
     return {"first": float(rel[0]), "min": float(rel.min()), "max": float(rel.max())} if len(rel) else {}
 
 

@@ -13,24 +13,14 @@ one event the GPU shows (deme_model/README.md, "Measured").
 import sys
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+sys.path[:0] = [str(ROOT), str(ROOT / "tools")]
+from deme_gpu_check import sticking_fn_over_weight  # noqa: E402
 from pyref import Simulation  # noqa: E402
 from stickslip import columns, plotstyle, scene  # noqa: E402
 from stickslip.kinds import drag  # noqa: E402
-
-
-def sticking_fn_ratio(sc, df):
-    """Fn / (W cos angle) of the scene's recorded contact from row 1 to its first slip."""
-    c = "-".join(sc.output.contacts[0])
-    slips = np.flatnonzero(df[f"{c}_slip"].to_numpy() > 0)
-    end = slips[0] if len(slips) else len(df)
-    angle = df[f"{sc.output.walls[0]}_angle"].to_numpy()
-    w = sc.grain_mass(sc.grains[0]) * 9.81 * np.cos(angle)
-    return df["t"].to_numpy()[1:end], (df[f"{c}_fn"].to_numpy() / w)[1:end]
 
 
 def main(series=ROOT / "deme_model/measured", png=None):
@@ -55,7 +45,7 @@ def main(series=ROOT / "deme_model/measured", png=None):
     left.set_ylim(0, 0.56)
     left.legend(loc="lower right", fontsize=8)
 
-    t, ratio = sticking_fn_ratio(st, gpu_tilt)
+    t, ratio = sticking_fn_over_weight(st, gpu_tilt)
     right.plot(t, ratio, color="C0", lw=0.8, label="DEM-Engine on a GPU")
     right.axhline(1.0, color="gray", lw=0.6, ls="--")
     right.set_xlabel("time (s): the tilt, §3.2, until the first slip")
