@@ -5,6 +5,10 @@
 # Setup: Debian packages (when root; otherwise it says what to install), a Python
 # virtual environment in .venv with the project installed, the LIGGGHTS plugin, and the LAMMPS
 # plugin (with the LAMMPS headers it needs, taken from Debian's source package).
+# STICKSLIP_SOURCE_BUILDS (a comma-separated list; .ci/run sets it) also builds engines from
+# Debian's source packages, once, cached in build/ (a second set-up costs seconds):
+#   lammps-2025   LAMMPS 4 Feb 2025 (Debian 13's source) with the tangential sub-model
+#                 stick_slip compiled in: build/lammps_2025/build/lmp (~3 min on 2 cores)
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -96,11 +100,67 @@ setup_lammps_plugin() {
     cmake --build build/lammps_plugin -j 2 >/dev/null
 }
 
+wants_source_build() {
+    case ",${STICKSLIP_SOURCE_BUILDS:-}," in *",$1,"*) return 0 ;; *) return 1 ;; esac
+}
+
+fetch_debian_source() {
+    # fetch_debian_source SUITE PACKAGE VERSION DIR: the source package's tarballs into DIR,
+    # from Debian's registry, through a sources list of its own (the system's apt lists are
+    # untouched). apt also asks for the .dsc, which the registry may not serve: the
+    # tarballs are checked instead (apt verified their hashes against the suite's index).
+    local suite=$1 package=$2 version=$3 dir=$4 apt="$4/apt"
+    ls "$dir"/"${package}"_*.orig.tar.* >/dev/null 2>&1 && return 0
+    mkdir -p "$apt/lists/partial" "$apt/cache/archives/partial"
+    echo "deb-src [signed-by=/usr/share/keyrings/debian-archive-keyring.gpg] http://deb.debian.org/debian $suite main" \
+        > "$apt/sources.list"
+    local opts=(-o Dir::Etc::sourcelist="$PWD/$apt/sources.list" -o Dir::Etc::sourceparts=-
+                -o Dir::State::Lists="$PWD/$apt/lists" -o Dir::Cache="$PWD/$apt/cache"
+                -o APT::Sandbox::User="$(id -un)" -o Debug::NoLocking=1)
+    apt-get "${opts[@]}" update -qq
+    (cd "$dir" && apt-get "${opts[@]}" source --download-only -qq "$package=$version" >/dev/null 2>&1) || true
+    if ! ls "$dir"/"${package}"_*.orig.tar.* >/dev/null 2>&1; then
+        echo "setup: could not download Debian's $package $version source from $suite" >&2
+        return 1
+    fi
+}
+
+setup_lammps_2025() {
+    # LAMMPS 4 Feb 2025 from Debian 13's source (132 MB, downloaded once), the smallest build
+    # that serves: core + GRANULAR + PLUGIN, MPI (Debian 12's OpenMPI), shared library, with
+    # lammps_plugin/granular/ copied into src/GRANULAR/ as a user would. Sources whose copy
+    # changed are copied again and rebuilt (cmake reconfigures: the sub-model registry is
+    # generated at configure time).
+    wants_source_build lammps-2025 || return 0
+    local top=build/lammps_2025 version=20250204+dfsg.1-2 src
+    src=$top/source
+    if [ ! -f "$src/.complete" ]; then
+        echo "setup: LAMMPS 4 Feb 2025 from Debian 13's source (first time: ~3 min on 2 cores)"
+        fetch_debian_source trixie lammps "$version" "$top/download"
+        rm -rf "$src" && mkdir -p "$src"
+        tar -xJf "$top"/download/lammps_*.orig.tar.xz -C "$src" --strip-components=1 \
+            --exclude='*/examples' --exclude='*/doc' --exclude='*/potentials' --exclude='*/bench' \
+            --exclude='*/unittest' --exclude='*/tools' --exclude='*/python' --exclude='*/lib'
+        echo "$version" > "$src/.complete"
+    fi
+    local changed=0 f
+    for f in lammps_plugin/granular/*; do
+        cmp -s "$f" "$src/src/GRANULAR/${f##*/}" || { cp "$f" "$src/src/GRANULAR/"; changed=1; }
+    done
+    if [ ! -f "$top/build/CMakeCache.txt" ] || [ "$changed" = 1 ]; then
+        cmake -S "$src/cmake" -B "$top/build" -C "$src/cmake/presets/all_off.cmake" -D PKG_GRANULAR=on \
+              -D PKG_PLUGIN=on -D BUILD_MPI=on -D BUILD_SHARED_LIBS=on -D LAMMPS_EXCEPTIONS=on \
+              -D BUILD_OMP=off -D CMAKE_BUILD_TYPE=Release >/dev/null
+    fi
+    cmake --build "$top/build" -j "$(nproc)" >/dev/null
+}
+
 setup() {
     setup_system
     setup_python
     setup_plugin
     setup_lammps_plugin
+    setup_lammps_2025
 }
 
 case "${1:-}" in
