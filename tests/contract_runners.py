@@ -9,6 +9,7 @@ SHARED_KERNEL). An engine whose record has no spring returns "D": None (LAMMPS).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import subprocess
@@ -349,30 +350,113 @@ neigh_modify delay 0 every 1 check yes
 """
 
 
-def _lammps_batch_script(cases):
-    """One script running every case of `cases` side by side (see above); case k's grain i
-    is atom k+1 (walls) or 2k+1 (pairs; j: 2k+2), its record in dump.case<k> (walls) or
-    dump.pairs."""
+class LegacyStyles:
+    """The contract in lammps_plugin/'s styles (Debian's LAMMPS): gran/hooke/stickslip and
+    wall/gran/stickslip with the law's keywords; compute pair/local's record RECORD_COLUMNS."""
+    record = RECORD_COLUMNS
+
+    @staticmethod
+    def pair_lines(case):
+        return [f"pair_style gran/hooke/stickslip {lammps_coefficients(case)} {lammps_keywords(case)}",
+                "pair_coeff * *"]
+
+    @staticmethod
+    def pair_coeff(t, case):
+        return f"pair_coeff {t} {t} mu_s {_f(case.mu_s)} mu_k {_f(case.mu_k)}"
+
+    @staticmethod
+    def wall(k, case):
+        return (f"fix w{k} i{k} wall/gran/stickslip hooke/history {lammps_coefficients(case)} zplane 0.0 NULL "
+                f"{lammps_keywords(case)}")
+
+    @staticmethod
+    def turn(k, a, seg, base, start):
+        """Case k's pair (atoms a, a+1) turned rigidly about z through `base` from step
+        `start` on: fix move rotate, which spins both grains at omega too (V_s = 0 with the
+        law's lever arms, the middle of the overlap)."""
+        period = 2 * math.pi / seg.omega
+        return [f"group g{k} id {a} {a + 1}",
+                f"fix turn{k} g{k} move rotate {_f(base[0])} {_f(base[1])} {_f(base[2])} 0 0 1 {_f(period)}"]
+
+
+def granular_model(case, record=True):
+    """The case's contact in LAMMPS 2025's granular syntax (stickslip/adapters/lammps_granular.py):
+    the sub-model's tangential dashpot is x times the normal damping's prefactor, nu_s = x nu_n.
+    A case with a dashpot but no normal damping never moves along its normal (asserted), so
+    there nu_n = 1 changes no force (v_n = 0 exactly) and x = nu_s."""
+    nu_n = case.nu_n
+    if case.nu_s > 0 and nu_n == 0:
+        axis = 2 if case.geometry == "wall" else 0
+        assert all(seg.velocity[axis] == 0 and not seg.omega for seg in case.segments), case.name
+        nu_n = 1.0
+    x = case.nu_s / nu_n if case.nu_s > 0 else 0.0
+    assert x * nu_n == case.nu_s
+    name = ("stick_slip" + ("/total" if case.reset == "total" else "") + ("/exact" if case.timing == "exact" else "")
+            + ("/record" if record else ""))
+    return (f"hooke {_f(lc.KN)} {_f(nu_n)} damping velocity tangential {name} {_f(lc.KS)} {_f(x)} "
+            f"{_f(case.mu_s)} {_f(case.mu_k)} limit_damping")
+
+
+class GranularSubModel:
+    """The contract in LAMMPS 2025's granular model with the sub-model stick_slip/record:
+    pair_style granular and fix wall/gran granular (per-atom columns 9-13, as the legacy
+    wall's); compute pair/local's record p13-p17 (Fn, F_s, slips)."""
+    record = (13, 14, 15, 16, 17)
+
+    @staticmethod
+    def pair_lines(case):
+        return ["pair_style granular", f"pair_coeff * * {granular_model(case)}"]
+
+    @staticmethod
+    def pair_coeff(t, case):
+        return f"pair_coeff {t} {t} {granular_model(case)}"
+
+    @staticmethod
+    def wall(k, case):
+        return f"fix w{k} i{k} wall/gran granular {granular_model(case)} zplane 0.0 NULL contacts"
+
+    @staticmethod
+    def turn(k, a, seg, base, start):
+        """The rigid turn with the spins at which LAMMPS' granular kinematics see no sliding:
+        they take V_s with the radii as lever arms, so a pair spinning at omega, as fix move
+        rotate spins it, slides at delta*omega; at omega*d/(r_i + r_j) it does not (d = 2R -
+        delta the distance of the centres). Each grain moves on its circle through fix move
+        variable (which leaves the spin as set)."""
+        d = 2 * lc.R - seg.delta
+        w, h = seg.omega, d / 2
+        theta = f"({_f(w * lc.DT)}*(step-{start}))"
+        lines = [f"set atom {a} omega 0 0 {_f(w * d / (2 * lc.R))}", f"set atom {a + 1} omega 0 0 {_f(w * d / (2 * lc.R))}"]
+        for b, sign in ((0, -1.0), (1, 1.0)):  # i at base - h x, j at base + h x
+            r = sign * h
+            lines += [f"variable tdx{k}{b} equal {_f(r)}*(cos{theta}-1)", f"variable tdy{k}{b} equal {_f(r)}*sin{theta}",
+                      f"variable tvx{k}{b} equal {_f(-r * w)}*sin{theta}", f"variable tvy{k}{b} equal {_f(r * w)}*cos{theta}",
+                      f"group t{k}{b} id {a + b}",
+                      f"fix turn{k}{b} t{k}{b} move variable v_tdx{k}{b} v_tdy{k}{b} NULL v_tvx{k}{b} v_tvy{k}{b} NULL"]
+        return lines
+
+
+def _lammps_batch_script(cases, styles=LegacyStyles):
+    """One script running every case of `cases` side by side (see above) in `styles`' syntax;
+    case k's grain i is atom k+1 (walls) or 2k+1 (pairs; j: 2k+2), its record in dump.case<k>
+    (walls) or dump.pairs."""
     pair = cases[0].geometry == "pair"
     lines = [LAMMPS_HEAD.format(ntypes=len(cases), dt=_f(lc.DT))]
     if pair:
-        lines += [f"pair_style gran/hooke/stickslip {lammps_coefficients(cases[0])} {lammps_keywords(cases[0])}",
-                  "pair_coeff * *"]
+        lines += styles.pair_lines(cases[0])
     turns = {}  # the step a turn begins after -> [(k, its segment, its centre)]
     for k, case in enumerate(cases):
         a = _first_atom(case, k)
         base = np.array([4.0 * (k % 7) - 12.0, 4.0 * (k // 7) - 12.0, 0.0])
         x0 = rest_positions(case, case.segments[0].delta) + base
         if pair:  # (j stays where it is: i alone moves, along the normal too)
-            lines.append(f"pair_coeff {k + 1} {k + 1} mu_s {_f(case.mu_s)} mu_k {_f(case.mu_k)}")
+            lines.append(styles.pair_coeff(k + 1, case))
         for b, x in enumerate(x0):
             v = case.segments[0].velocity if b == 0 else (0.0, 0.0, 0.0)
             lines += [f"create_atoms {k + 1} single {_f(x[0])} {_f(x[1])} {_f(x[2])} units box",
                       f"set atom {a + b} diameter {_f(2 * lc.R)} density 1000 vx {_f(v[0])} vy {_f(v[1])} vz {_f(v[2])}"]
         lines.append(f"group i{k} id {a}")
         if not pair:
-            lines += [f"fix w{k} i{k} wall/gran/stickslip hooke/history {lammps_coefficients(case)} zplane 0.0 NULL "
-                      f"{lammps_keywords(case)}",
+            lines += [styles.wall(k, case),
                       f"dump d{k} i{k} custom 1 dump.case{k} id " + " ".join(f"f_w{k}[{c}]" for c in (9, 10, 11, 12, 13)),
                       f"dump_modify d{k} format float %.17g"]
         # the moving grain's place (from where it was made) and velocity, segment by segment
@@ -393,28 +477,26 @@ def _lammps_batch_script(cases):
             lines.append(f"variable {q}{k} equal {_piecewise(s)}")
         lines.append(f"fix mv{k} i{k} move variable " + " ".join(f"v_{q}{k}" for q in spans))
     if pair:
-        lines += lammps_pair_local(RECORD_COLUMNS)
+        lines += lammps_pair_local(styles.record)
         lines += ["dump x all custom 1 dump.atoms id x y z", "dump_modify x format float %.17g sort id"]
     done = 0
     for start in sorted(turns):
         lines.append(f"run {start - done}")
         for k, seg, base in turns[start]:
-            period = 2 * math.pi / seg.omega
-            a = _first_atom(cases[k], k)
-            lines += [f"unfix mv{k}", f"group g{k} id {a} {a + 1}",
-                      f"fix turn{k} g{k} move rotate {_f(base[0])} {_f(base[1])} {_f(base[2])} 0 0 1 {_f(period)}"]
+            lines += [f"unfix mv{k}"] + styles.turn(k, _first_atom(cases[k], k), seg, base, start)
         done = start
     lines.append(f"run {max(c.steps for c in cases) - done}")
     return "\n".join(lines) + "\n"
 
 
-def _lammps_batch(cases):
-    """Runs the batch; {case name: trace}."""
+def _lammps_batch(cases, styles=LegacyStyles, exe=None):
+    """Runs the batch in `styles`' syntax on `exe` (None: the legacy styles' launcher);
+    {case name: trace}."""
     import lammps_runs
 
     with tempfile.TemporaryDirectory(prefix="contract-lammps-") as tmp:
         work = Path(tmp)
-        lammps_runs.run_lammps(work, "contract", _lammps_batch_script(cases))
+        lammps_runs.run_lammps(work, "contract", _lammps_batch_script(cases, styles), exe=exe)
         if cases[0].geometry == "wall":
             records = [lammps_runs.read_dump(work / f"dump.case{k}") for k in range(len(cases))]
         else:
@@ -492,14 +574,26 @@ def run_lammps(case):
     """The LAMMPS plugin's law (lammps_plugin/stick_slip_law.h), read from its record: the
     wall's per-atom columns 9-13 or compute pair/local's p11, p1-p3, p12 (Fn, F_s on i,
     slips since the contact began). The case's whole batch runs at its first row."""
-    key = _lammps_key(case)
+    key = ("legacy",) + _lammps_key(case)
     if key not in _LAMMPS_TRACES:
-        batch = [c for c in lc.CASES if _lammps_key(c) == key]
+        batch = [c for c in lc.CASES if _lammps_key(c) == key[1:]]
         _LAMMPS_TRACES[key] = _lammps_batch(batch)
     return _LAMMPS_TRACES[key][case.name]
 
 
-def lammps_type_pairs(timing="step", nu_s=0.0, record=True):
+def run_lammps_granular(case):
+    """The sub-model stick_slip (lammps_plugin/granular/) in LAMMPS 2025, read from its
+    record (/record): the wall's per-atom columns 9-13 or compute pair/local's p13-p17."""
+    from stickslip.adapters import lammps_granular
+
+    key = ("granular",) + _lammps_key(case)
+    if key not in _LAMMPS_TRACES:
+        batch = [c for c in lc.CASES if _lammps_key(c) == key[1:]]
+        _LAMMPS_TRACES[key] = _lammps_batch(batch, GranularSubModel, lammps_granular.LAUNCHER)
+    return _LAMMPS_TRACES[key][case.name]
+
+
+def lammps_type_pairs(timing="step", nu_s=0.0, record=True, styles=None, exe=None):
     """Six grain pairs side by side, one per pair of types 1..3, each with its own mu_s, mu_k
     from pair_coeff (law_contract.TYPE_PAIRS; LAMMPS' wall has one mu_s and mu_k per fix, so
     type 1 is a grain type here and (1, 1) a pair too), grain i sliding at one X a step.
@@ -507,16 +601,23 @@ def lammps_type_pairs(timing="step", nu_s=0.0, record=True):
     normal x, sliding along y (the directions test_coefficients_per_type_pair expects).
     Runs lc.TYPE_PAIR_STEPS steps; returns {type pair: (steps, k) array}, each step's
     compute pair/local values for the contact, as the force on i: with record, Fn (p11),
-    F_s (p1-p3), slips (p12); without, p1-p3 (the force single() re-evaluates)."""
+    F_s (p1-p3), slips (p12); without, p1-p3 (the force single() re-evaluates). styles:
+    None, the legacy styles; GranularSubModel, LAMMPS 2025's granular model (on `exe`),
+    whose record is p13, p14-p16, p17."""
     import lammps_runs
 
     coeff = lc.type_pair_coefficients()
     d = 2 * lc.R - lc.DELTA
     law = lc.Case("", "", "pair", (), 0.5, 0.5, nu_s=nu_s, timing=timing)  # (every pair's mu from pair_coeff)
-    lines = [LAMMPS_HEAD.format(ntypes=3, dt=_f(lc.DT)),
-             f"pair_style gran/hooke/stickslip {lammps_coefficients(law)} {lammps_keywords(law, record)}",
-             "pair_coeff * *"]
-    lines += [f"pair_coeff {i} {j} mu_s {_f(ms)} mu_k {_f(mk)}" for (i, j), (ms, mk) in coeff.items()]
+    lines = [LAMMPS_HEAD.format(ntypes=3, dt=_f(lc.DT))]
+    if styles is None:
+        lines += [f"pair_style gran/hooke/stickslip {lammps_coefficients(law)} {lammps_keywords(law, record)}",
+                  "pair_coeff * *"]
+        lines += [f"pair_coeff {i} {j} mu_s {_f(ms)} mu_k {_f(mk)}" for (i, j), (ms, mk) in coeff.items()]
+    else:
+        lines += ["pair_style granular", f"pair_coeff * * {granular_model(law, record)}"]
+        lines += [f"pair_coeff {i} {j} {granular_model(dataclasses.replace(law, mu_s=ms, mu_k=mk), record)}"
+                  for (i, j), (ms, mk) in coeff.items()]
     first = {}
     for k, (ti, tj) in enumerate(sorted(coeff)):
         across = np.array([0.0, 1.0, 0.0]) if 1 in (ti, tj) else np.array([1.0, 0.0, 0.0])
@@ -528,21 +629,21 @@ def lammps_type_pairs(timing="step", nu_s=0.0, record=True):
                       f"set atom {2 * k + b + 1} diameter {_f(2 * lc.R)} density 1000 "
                       f"vx {_f(v[0])} vy {_f(v[1])} vz {_f(v[2])}"]
         first[(ti, tj)] = 2 * k + 1
-    columns = RECORD_COLUMNS if record else (1, 2, 3)
-    forces = [columns.index(1) + c for c in range(3)]
+    columns = (styles or LegacyStyles).record if record else (1, 2, 3)
+    forces = [1 + c for c in range(3)] if record else [0, 1, 2]  # (the record: Fn, then the force)
     lines += lammps_pair_local(columns) + [f"run {lc.TYPE_PAIR_STEPS}"]
     with tempfile.TemporaryDirectory(prefix="contract-lammps-") as tmp:
         work = Path(tmp)
-        lammps_runs.run_lammps(work, "types", "\n".join(lines) + "\n")
+        lammps_runs.run_lammps(work, "types", "\n".join(lines) + "\n", exe=exe)
         pairs = lammps_runs.read_dump(work / "dump.pairs")
     return {pair: np.array([lammps_pair_row(pairs[s + 1], a, forces) for s in range(lc.TYPE_PAIR_STEPS)])
             for pair, a in first.items()}
 
 
-def run_lammps_type_pairs(timing="step"):
+def run_lammps_type_pairs(timing="step", styles=None, exe=None):
     """lammps_type_pairs with the record: {type pair: trace}."""
     out = {}
-    for pair, rows in lammps_type_pairs(timing).items():
+    for pair, rows in lammps_type_pairs(timing, styles=styles, exe=exe).items():
         tr = _empty(lc.TYPE_PAIR_STEPS)
         tr["D"] = None  # not in LAMMPS' record
         tr["fn"], tr["F"], tr["slips"] = rows[:, 0], rows[:, 1:4], rows[:, 4].astype(int)
@@ -550,8 +651,15 @@ def run_lammps_type_pairs(timing="step"):
     return out
 
 
-RUNNERS = {"pyref": run_pyref, "liggghts": run_liggghts, "lammps": run_lammps}
+def run_lammps_granular_type_pairs(timing="step"):
+    from stickslip.adapters import lammps_granular
+
+    return run_lammps_type_pairs(timing, GranularSubModel, lammps_granular.LAUNCHER)
+
+
+RUNNERS = {"pyref": run_pyref, "liggghts": run_liggghts, "lammps": run_lammps, "lammps_granular": run_lammps_granular}
 # Cases an engine cannot express, and why (the README's table shows them).
-TYPE_PAIR_RUNNERS = {"liggghts": run_liggghts_type_pairs, "lammps": run_lammps_type_pairs}
+TYPE_PAIR_RUNNERS = {"liggghts": run_liggghts_type_pairs, "lammps": run_lammps_type_pairs,
+                     "lammps_granular": run_lammps_granular_type_pairs}
 NO_TYPE_PAIRS = {"pyref": "one material per scene: one mu_s, mu_k for every contact"}
 

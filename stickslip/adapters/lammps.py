@@ -102,6 +102,20 @@ class _Script:
         keywords = f"mu_k {_fmt(c.mu_k)} reset {c.reset} slip_timing {c.slip_timing} {LAW_KEYWORDS}"
         return args, keywords
 
+    # The contact model's lines, the one part a LAMMPS with another granular syntax changes
+    # (stickslip/adapters/lammps_granular.py): the pair style, a wall's fix, pair/local's record.
+    PAIR_RECORD = "p11 p1 p2 p3 p12"  # Fn, the tangential force on the first grain, its slip count
+
+    def _pair_lines(self):
+        args, keywords = self._coefficients()
+        return [f"pair_style gran/hooke/stickslip {args} {keywords}", "pair_coeff * *"]
+
+    def _wall_fix(self, fid, where):
+        """The fix of a wall at `where` (`xplane lo hi [shear ...]` or `region ID`)."""
+        args, keywords = self._coefficients()
+        style = "wall/gran/region/stickslip" if where.startswith("region ") else "wall/gran/stickslip"
+        return f"fix {fid} all {style} hooke/history {args} {where} {keywords}"
+
     def _build(self):
         sc, eff = self.scene, self.scene.effects
         lo, hi, _ = box(sc)
@@ -116,10 +130,9 @@ class _Script:
             self.add(f"set atom {self.ids[g.name]} mass {_fmt(sc.grain_mass(g))}")
         rmax = max(g.radius for g in sc.grains)
         self.add(f"neighbor {_fmt(0.2 * rmax)} bin", "neigh_modify delay 0 every 1 check yes")
-        args, keywords = self._coefficients()
-        self.add(f"pair_style gran/hooke/stickslip {args} {keywords}", "pair_coeff * *", f"timestep {_fmt(sc.dt)}")
+        self.add(*self._pair_lines(), f"timestep {_fmt(sc.dt)}")
         for k, w in enumerate(sc.walls):
-            self._wall(k, w, args, keywords)
+            self._wall(k, w)
         if eff["gravity"]:
             self.add(*ramp_script.gravity(sc))
         # rotation off: integrate translation only, spins stay zero
@@ -144,7 +157,7 @@ class _Script:
             self.add("fix twod all enforce2d")
         self._output()
 
-    def _wall(self, k, w, args, keywords):
+    def _wall(self, k, w):
         sc = self.scene
         fid = f"w{k}"
         self.walls[w.name] = fid
@@ -156,7 +169,7 @@ class _Script:
             # sliding along itself (one axis) is stock's `shear` (the same velocity at every step)
             side = f"{_fmt(w.point[j])} NULL" if w.normal[j] > 0 else f"NULL {_fmt(w.point[j])}"
             shear = f" shear {'xyz'[along[0]]} {_fmt(v[along[0]])}" if along else ""
-            self.add(f"fix {fid} all wall/gran/stickslip hooke/history {args} {'xyz'[j]}plane {side}{shear} {keywords}")
+            self.add(self._wall_fix(fid, f"{'xyz'[j]}plane {side}{shear}"))
             return
         region = f"region r{k} plane {_vec(w.point)} {_vec(w.normal)} side in units box"
         if w.rotation is not None:
@@ -178,7 +191,7 @@ class _Script:
             self.notes.append(f"wall {w.name} moves as a LAMMPS region, which has no velocity in the set-up force "
                               "evaluation (pyref: the wall's velocity): the first half step differs if it touches "
                               "a grain")
-        self.add(region, f"fix {fid} all wall/gran/region/stickslip hooke/history {args} region r{k} {keywords}")
+        self.add(region, self._wall_fix(fid, f"region r{k}"))
 
     def _output(self):
         """Dumps of what the scene records, at its interval, and nothing else: the grains
@@ -195,7 +208,7 @@ class _Script:
         self.add(dump, "dump_modify atoms sort id", _full_precision("atoms"))
         # a pair's record: ids, Fn, the tangential force on the first grain, its slip count
         local = "c_{0}ids[1] c_{0}ids[2] c_{0}[1] c_{0}[2] c_{0}[3] c_{0}[4] c_{0}[5]"
-        record = "pair/local p11 p1 p2 p3 p12 cutoff radius"
+        record = f"pair/local {self.PAIR_RECORD} cutoff radius"
         if pair_contacts:
             # pair/local keeps the pairs with both grains in its group
             self.add(f"compute pairs rec {record}", "compute pairsids rec property/local patom1 patom2 cutoff radius",
@@ -241,11 +254,17 @@ def _timeseries(script, work):
 
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
-    scene.refuse_unsupported("LAMMPS", ("periodic", "gravity_ramp", "bulk"))
-    work = work_folder(scene, out_dir, "LAMMPS")
-    script = _Script(scene, work)
+    return run_with(_Script, launcher or LAUNCHER, "LAMMPS", scene, out_dir, progress, np_ranks)
+
+
+def run_with(script_class, launcher, engine, scene, out_dir, progress, np_ranks):
+    """A scene through `script_class`'s input script on `launcher` (the run of both LAMMPS
+    adapters); the work folder is out_dir/<engine, lower case>."""
+    scene.refuse_unsupported(engine, ("periodic", "gravity_ramp", "bulk"))
+    work = work_folder(scene, out_dir, engine)
+    script = script_class(scene, work)
     (work / "in.scene").write_text(script.text())
-    cmd = [str(launcher or LAUNCHER), "-in", "in.scene", "-log", "log.lammps", "-echo", "none", "-nocite"]
-    loop_time = run_script("LAMMPS", cmd, work, scene.steps, progress, np_ranks, env={"OMP_NUM_THREADS": "1"})
+    cmd = [str(launcher), "-in", "in.scene", "-log", "log.lammps", "-echo", "none", "-nocite"]
+    loop_time = run_script(engine, cmd, work, scene.steps, progress, np_ranks, env={"OMP_NUM_THREADS": "1"})
     df = _timeseries(script, work)
     return RunResult(df, ramp_script.steps_run(scene, df), loop_time, notes=script.notes)

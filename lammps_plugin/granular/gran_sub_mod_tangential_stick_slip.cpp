@@ -1,0 +1,246 @@
+/* ----------------------------------------------------------------------
+   stickslip: the stick-slip tangential law of Khellaf & Mansouri (2024) as a tangential
+   sub-model of LAMMPS' granular model (docs/law.md; equation numbers are the paper's).
+
+   This file is the law on LAMMPS 2Aug2023 and later. The host computes the geometry, the
+   sliding velocity V_s (gm->vtr, with the radii as lever arms), the normal force and its
+   damping, and applies the force and torques; this sub-model turns and loads the spring D
+   and decides stick or slip. Its step-timing arithmetic is linear_history's operation for
+   operation (the turn of D keeping its length included), so that with mu_k = mu_s and
+   /total it gives linear_history's run bit for bit. The exact slip timing's
+   engine-independent part (E1-E7) is exact_slip_timing.h, shared with the styles of
+   lammps_plugin/ for Debian's LAMMPS.
+------------------------------------------------------------------------- */
+
+#include "gran_sub_mod_tangential_stick_slip.h"
+
+#include "error.h"
+#include "exact_slip_timing.h"
+#include "gran_sub_mod_damping.h"
+#include "gran_sub_mod_normal.h"
+#include "granular_model.h"
+#include "math_extra.h"
+
+#include <cmath>
+#include <string>
+
+using namespace LAMMPS_NS;
+using namespace Granular_NS;
+using namespace MathExtra;
+
+// linear_history's and mindlin's: D is turned into the tangent plane only when its normal
+// part carries more than EPSILON of the threshold (below that the turn changes nothing a
+// force could show)
+static constexpr double EPSILON = 1e-10;
+
+/* ---------------------------------------------------------------------- */
+
+GranSubModTangentialStickSlip::GranSubModTangentialStickSlip(GranularModel *gm, LAMMPS *lmp) :
+    GranSubModTangential(gm, lmp), xt(0.0), kin(0.0), ratio(1.0), mindlin(false), reset_total(false),
+    exact(false), record(false)
+{
+  num_coeffs = 4;
+  size_history = SIZE_PLAIN;
+}
+
+/* ----------------------------------------------------------------------
+   the options from the name the input gave (the header's GranSubModStyle lines):
+   stick_slip[/total][/exact][/record]
+------------------------------------------------------------------------- */
+
+void GranSubModTangentialStickSlip::read_options()
+{
+  reset_total = name.find("/total") != std::string::npos;
+  exact = name.find("/exact") != std::string::npos;
+  record = name.find("/record") != std::string::npos;
+
+  size_history = record ? SIZE_RECORD : SIZE_PLAIN;
+  nsvector = record ? NRECORD : 0;
+  // seen from the other body of a pair, D and F_s change sign; Fn, the slip count and the
+  // work do not
+  delete[] transfer_history_factor;
+  transfer_history_factor = nullptr;
+  nondefault_history_transfer = record ? 1 : 0;
+  if (record) {
+    transfer_history_factor = new double[SIZE_RECORD];
+    for (int i = 0; i < SIZE_RECORD; i++) transfer_history_factor[i] = -1.0;
+    transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP] = transfer_history_factor[HIST_WORK] = 1.0;
+  }
+}
+
+/* ----------------------------------------------------------------------
+   coefficients: Ks (or NULL), x_gamma,t, mu_s, mu_k; each bad one stops the run with one
+   line naming it and its allowed range (docs/law.md "Parameter rules")
+------------------------------------------------------------------------- */
+
+void GranSubModTangentialStickSlip::coeffs_to_local()
+{
+  read_options();
+  const double ks = coeffs[0], mu_k = coeffs[3];
+  xt = coeffs[1];
+  mu = coeffs[2];
+
+  mindlin = ks == -1.0;    // NULL
+  if (!mindlin && !(ks > 0.0 && std::isfinite(ks)))
+    error->all(FLERR,
+               "tangential {}: Ks = {} is outside its allowed range: > 0, or NULL (Mindlin's 8 G* a, with a "
+               "normal model of material properties)",
+               name, ks);
+  if (!(xt >= 0.0 && std::isfinite(xt)))
+    error->all(FLERR, "tangential {}: x_gamma,t = {} is outside its allowed range: >= 0", name, xt);
+  if (!(mu > 0.0 && std::isfinite(mu)))
+    error->all(FLERR, "tangential {}: mu_s = {} is outside its allowed range: > 0", name, mu);
+  if (!(mu_k >= 0.5 * mu && mu_k <= mu))
+    error->all(FLERR, "tangential {}: mu_k = {} is outside its allowed range [mu_s/2, mu_s] = [{}, {}]", name,
+               mu_k, 0.5 * mu, mu);
+
+  if (mindlin) {
+    if (!gm->normal_model->get_material_properties())
+      error->all(FLERR,
+                 "tangential {}: Ks = NULL needs a normal model with material properties (hertz/material, dmt, "
+                 "jkr, mdr); give Ks instead",
+                 name);
+    const double Emod = gm->normal_model->get_emod(), poiss = gm->normal_model->get_poiss();
+    // Mindlin's stiffness per unit contact radius, as the mindlin sub-model's
+    k = 8.0 * (gm->contact_type == PAIR ? mix_stiffnessG(Emod, Emod, poiss, poiss) : mix_stiffnessG_wall(Emod, poiss));
+  } else {
+    k = ks;
+  }
+  contact_radius_flag = mindlin ? 1 : 0;
+
+  kin = 2.0 * mu_k - mu;    // Fmin = (2 mu_k - mu_s) Fn: mean mu_k Fn over a saw-tooth
+  ratio = kin / mu;
+}
+
+/* ---------------------------------------------------------------------- */
+
+void GranSubModTangentialStickSlip::mix_coeffs(double *icoeffs, double *jcoeffs)
+{
+  // geometric means, as the other sub-models (they keep mu_s/2 <= mu_k <= mu_s); NULL
+  // (Mindlin's stiffness) if either side has it
+  coeffs[0] = (icoeffs[0] == -1.0 || jcoeffs[0] == -1.0) ? -1.0 : mix_geom(icoeffs[0], jcoeffs[0]);
+  for (int i = 1; i < num_coeffs; i++) coeffs[i] = mix_geom(icoeffs[i], jcoeffs[i]);
+  coeffs_to_local();
+}
+
+/* ----------------------------------------------------------------------
+   with /record: the contact's record as the sub-model's output values (compute pair/local
+   p13-p18, the wall fixes' per-atom columns 9-14)
+------------------------------------------------------------------------- */
+
+void GranSubModTangentialStickSlip::report_record(const double *history)
+{
+  double *out = &gm->svector[index_svector];
+  out[0] = history[HIST_FN];
+  for (int k = 0; k < 3; k++) out[1 + k] = history[HIST_FS + k];
+  out[4] = history[HIST_NSLIP];
+  out[5] = history[HIST_WORK];
+}
+
+/* ----------------------------------------------------------------------
+   docs/law.md steps 3-5 (and E0-E7 with /exact) at one contact for one force evaluation
+------------------------------------------------------------------------- */
+
+void GranSubModTangentialStickSlip::calculate_forces()
+{
+  double temp[3];
+  damp = xt * gm->damping_model->get_damp_prefactor();    // nu_s
+  const double fncrit = gm->normal_model->get_fncrit();      // |Fn| (adhesive models: their own)
+  const double Fscrit = fncrit * mu;                         // T = mu_s |Fn|
+  const double fmin = fncrit * kin;                          // Fmin (eq. 8)
+  const double ks = mindlin ? k * gm->contact_radius : k;
+  double *history = &gm->history[history_index];
+
+  if (gm->contact_type == PAIR && gm->calculate_svector) {
+    // pair granular's single() (compute pair/local): report, change nothing
+    if (record) {
+      copy3(&history[HIST_FS], gm->fs);
+      report_record(history);
+    } else {
+      // the force the law would apply now, with no time passing
+      scale3(-ks, history, gm->fs);
+      scale3(damp, gm->vtr, temp);
+      sub3(gm->fs, temp, gm->fs);
+      const double magfs = len3(gm->fs);
+      if (magfs >= Fscrit) scale3(magfs > 0.0 && lensq3(history) != 0.0 ? fmin / magfs : 0.0, gm->fs);
+    }
+    return;
+  }
+
+  const bool update = gm->history_update;    // false: a set-up evaluation, no time passes
+  const double before2 = record ? lensq3(history) : 0.0;
+
+  if (update) {
+    // step 3: turn D into the current tangent plane keeping its length (linear_history's
+    // arithmetic)
+    const double rsht = dot3(history, gm->nx);
+    if (fabs(rsht) * ks > EPSILON * Fscrit) {
+      const double shrmag = len3(history);
+      scale3(rsht, gm->nx, temp);
+      sub3(history, temp, history);
+      const double prjmag = len3(history);
+      scale3(prjmag > 0 ? shrmag / prjmag : 0, history);
+    }
+  }
+  double turned[3];    // D before the step's increment (the exact timing's start)
+  if (exact) copy3(history, turned);
+  if (update) {
+    // eq. 7: D += V_s dt
+    scale3(gm->dt, gm->vtr, temp);
+    add3(history, temp, history);
+  }
+
+  // eq. 5: the trial force, spring + dashpot
+  scale3(-ks, history, gm->fs);
+  scale3(damp, gm->vtr, temp);
+  sub3(gm->fs, temp, gm->fs);
+
+  // step 5: slip if |F_t| >= mu_s |Fn|
+  const double magfs = len3(gm->fs);
+  bool slipped = magfs >= Fscrit;
+  if (exact) {
+    // E0: |F| moves on a line in the step and is convex, so the step has no slip iff the
+    // trial force is below T at both ends; then the result is the step timing's. The
+    // trial force at the start holds the spring before its increment.
+    double start[3];
+    scale3(-ks, turned, start);
+    sub3(start, temp, start);
+    slipped = slipped || lensq3(start) >= Fscrit * Fscrit;
+    if (slipped) {
+      // E1-E7 (exact_slip_timing.h); E6 when nothing is added at a reset
+      const bool flow_law = ratio == 1.0 && (reset_total || damp == 0.0);
+      double applied[3], trial[3], stick;
+      stickslip::exact_slips(start, gm->vtr, Fscrit, fmin, ratio, ks, damp, update ? gm->dt : 0.0, reset_total,
+                             flow_law, applied, trial, stick);
+      copy3(applied, gm->fs);
+      // the spring holds the trial force at the end less the dashpot (eq. 5)
+      for (int i = 0; i < 3; i++) history[i] = -(trial[i] + temp[i]) / ks;
+    }
+  } else if (slipped) {
+    if (len3(history) != 0.0) {
+      // the force drops to Fmin along the trial force; eq. 8 resets the spring to hold
+      // Fmin alone, or with /total spring + dashpot (linear_history's rescale)
+      const double scale = magfs > 0.0 ? fmin * (1.0 / magfs) : 0.0;
+      scale3(scale, gm->fs, history);
+      if (reset_total) add3(history, temp, history);
+      scale3(-1.0 / ks, history);
+      scale3(scale, gm->fs);
+    } else {
+      // linear_history's rule: a zero spring (a new contact in a set-up evaluation) gets no
+      // tangential force when the dashpot alone reaches the threshold
+      zero3(gm->fs);
+    }
+  }
+
+  if (record) {
+    if (update) {
+      // docs/law.md "Energy": the work the contact received, -F_s.V_s dt, less the increase
+      // of the spring energy Ks |D|^2/2
+      history[HIST_WORK] += -dot3(gm->fs, gm->vtr) * gm->dt - 0.5 * ks * (lensq3(history) - before2);
+      if (slipped) history[HIST_NSLIP] += 1.0;
+    }
+    history[HIST_FN] = gm->Fntot;
+    copy3(gm->fs, &history[HIST_FS]);
+    if (gm->calculate_svector) report_record(history);    // (walls with per-atom output)
+  }
+}

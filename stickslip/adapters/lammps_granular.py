@@ -1,0 +1,90 @@
+"""Adapter for LAMMPS as granular users build it today (2Aug2023 and later): `pair_style
+granular` and `fix wall/gran granular` with the tangential sub-model `stick_slip`
+(lammps_plugin/granular/, compiled into the LAMMPS 4 Feb 2025 that
+`STICKSLIP_SOURCE_BUILDS=lammps-2025 ./run.sh setup` builds from Debian 13's source).
+
+The script is the LAMMPS adapter's (stickslip/adapters/lammps.py: grains, walls, gravity,
+integration, dumps) with the contact model in the granular syntax:
+`hooke Kn nu_n damping velocity tangential stick_slip[/total][/exact]/record Ks x nu_n mu_s mu_k
+limit_damping`. `damping velocity` makes nu_n absolute (docs/law.md step 2), and the
+sub-model's tangential damping is x times it, so x is nu_s/nu_n. The record (`/record`)
+gives the law's Fn, force and slip count: compute pair/local p13-p17 for grain pairs, the
+wall fixes' per-atom columns 9-13 (keyword `contacts`), the LAMMPS adapter's columns.
+
+Where this differs from docs/law.md (lammps_plugin/doc/gran_sub_mod_tangential_stick_slip.md):
+LAMMPS' granular model takes V_s with the radii as lever arms and a wall's torque at the
+radius (the law: the middle of the overlap), which only scenes with rotation see (the
+run's notes say so), and it has no tangential dashpot without a normal one.
+"""
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+from .lammps import REPO, _Script, _fmt, run_with
+
+NAME = "lammps_granular"
+# The LAMMPS 2025 build (./run.sh setup with STICKSLIP_SOURCE_BUILDS=lammps-2025). Defined here
+# only; STICKSLIP_LAMMPS_2025 points it at another build (tools/mutate_cpp.py: a mutant's).
+BUILD = Path(os.environ.get("STICKSLIP_LAMMPS_2025") or REPO / "build" / "lammps_2025" / "build")
+LAUNCHER = BUILD / "lmp"
+
+
+def available():
+    if not LAUNCHER.is_file():
+        return f"{LAUNCHER} missing (STICKSLIP_SOURCE_BUILDS=lammps-2025 ./run.sh setup builds LAMMPS 2025)"
+    return None
+
+
+def dashpot_ratio(nu_s, nu_n):
+    """x such that LAMMPS' tangential damping x * nu_n is nu_s to the last bit: nu_s/nu_n,
+    or a neighbour of it where that product rounds off nu_s."""
+    x = nu_s / nu_n
+    for candidate in (x, math.nextafter(x, math.inf), math.nextafter(x, -math.inf)):
+        if candidate * nu_n == nu_s:
+            return candidate
+    return x
+
+
+def sub_model_name(contact):
+    """`stick_slip` with the scene's options as the name's suffixes, and the record."""
+    return ("stick_slip" + ("/total" if contact.reset == "total" else "")
+            + ("/exact" if contact.slip_timing == "exact" else "") + "/record")
+
+
+def granular_model(scene):
+    """The granular model's words for the scene's contact (pair_coeff and every wall)."""
+    c, eff = scene.contact, scene.effects
+    nu_n = c.nu_n if eff["normal_damping"] else 0.0
+    nu_s = c.nu_s if eff["tangential_damping"] else 0.0
+    if nu_s > 0.0 and nu_n == 0.0:
+        raise ValueError("contact.nu_s: LAMMPS' granular model scales the tangential dashpot by the normal one, "
+                         "so nu_s > 0 needs nu_n > 0 (effects.normal_damping on)")
+    x = dashpot_ratio(nu_s, nu_n) if nu_s > 0.0 else 0.0
+    return (f"hooke {_fmt(c.kn)} {_fmt(nu_n)} damping velocity tangential {sub_model_name(c)} "
+            f"{_fmt(c.ks)} {_fmt(x)} {_fmt(c.mu_s)} {_fmt(c.mu_k)} limit_damping")
+
+
+class _GranularScript(_Script):
+    """The LAMMPS adapter's script with the contact model in the granular syntax."""
+
+    PAIR_RECORD = "p13 p14 p15 p16 p17"  # the sub-model's record: Fn, F_s on the first grain, slips
+
+    def _build(self):
+        if self.scene.effects["rotation"]:
+            self.notes.append("LAMMPS' granular model takes the sliding velocity with the radii as lever arms "
+                              "and a wall's torque at the radius (docs/law.md step 1: the middle of the overlap)")
+        super()._build()
+
+    def _pair_lines(self):
+        return ["pair_style granular", f"pair_coeff * * {granular_model(self.scene)}"]
+
+    def _wall_fix(self, fid, where):
+        style = "wall/gran/region" if where.startswith("region ") else "wall/gran"
+        # (the geometry words come after the model's; `contacts`: the per-atom record)
+        return f"fix {fid} all {style} granular {granular_model(self.scene)} {where} contacts"
+
+
+def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
+    return run_with(_GranularScript, launcher or LAUNCHER, "LAMMPS", scene, out_dir, progress, np_ranks)

@@ -1,0 +1,110 @@
+"""The tangential sub-model `stick_slip` in LAMMPS 2025's granular model (lammps_plugin/granular/,
+the adapter stickslip/adapters/lammps_granular.py) against pyref on the paper's cases.
+
+LAMMPS and pyref integrate the same way (tests/test_lammps_engine.py's docstring), and the
+adapter's granular model (`hooke Kn nu_n damping velocity tangential stick_slip/record Ks x mu_s
+mu_k limit_damping`, x chosen so that x * nu_n is nu_s to the last bit) is docs/law.md's law
+in the paper's cases, which lock rotation (so the lever arm, the one rule where LAMMPS'
+granular model differs from the law, does not enter): on the same scene and dt the runs differ
+by the order of floating-point operations only, and are held to tests/twin_bound.py's
+round-off bound, as the legacy styles are. Row 0 is compared too: the sub-model's record is
+written by the set-up's force evaluation.
+
+These tests need LAMMPS 2025 (STICKSLIP_SOURCE_BUILDS=lammps-2025 ./run.sh setup; CI builds
+it): they skip without it, and fail instead when the set-up was asked for it (conftest).
+Costs (2 cores): drag 0.5 s, tray (0.5 s simulated) 1 s, tilt 1.5 s a timing; pyref's runs
+are shared with the other engines' tests (paper_case).
+"""
+
+import pytest
+
+from stickslip import scene as scene_mod
+from stickslip.adapters import lammps_granular
+from conftest import needs_engine, paper_case, skip_engine
+from twin_bound import assert_round_off_apart
+
+pytestmark = needs_engine("lammps_granular")
+
+
+def run_granular(name, tmp_path, ranks=1, **kw):
+    sc = scene_mod.load(name, **kw)
+    return sc, lammps_granular.run(sc, tmp_path, np_ranks=ranks).timeseries
+
+
+def pyref_case(name, timing, **kw):
+    return (paper_case(name, **kw) if timing == "step" else paper_case(name, slip_timing=timing, **kw))[1]
+
+
+def test_the_build_is_there():
+    """Under CI (whose set-up builds LAMMPS 2025) a missing build fails here instead of
+    skipping every test of this file."""
+    skip_engine("lammps_granular")
+
+
+@pytest.mark.parametrize("timing", ["step", "exact"])
+def test_drag_is_pyrefs_twin(tmp_path, timing):
+    """Every row of the drag (2500 steps; a primitive wall: fix wall/gran granular) within
+    round-off of pyref's, in both slip timings."""
+    sc, dl = run_granular("drag", tmp_path, slip_timing=timing)
+    text = (tmp_path / "lammps" / "in.scene").read_text()
+    assert "wall/gran granular hooke" in text and "tangential stick_slip" in text
+    assert_round_off_apart(sc, dl, pyref_case("drag", timing), slips_where_pressed=True)
+    assert dl["grain-floor_slip"].sum() >= 5
+
+
+@pytest.mark.parametrize("timing", ["step", "exact"])
+def test_tilt_is_pyrefs_twin(tmp_path, timing):
+    """Every row of the tilt (125 000 steps: the plate turning and stopping, stick,
+    stick-slip and sliding) within round-off of pyref's; the plate is a region plane turned
+    by `rotate v_theta` under fix wall/gran/region granular."""
+    sc, dl = run_granular("tilt", tmp_path, slip_timing=timing)
+    text = (tmp_path / "lammps" / "in.scene").read_text()
+    assert "wall/gran/region granular" in text and "rotate v_theta0" in text
+    assert_round_off_apart(sc, dl, pyref_case("tilt", timing), slips_where_pressed=True)
+    assert dl["grain-plate_slip"].sum() > 100
+
+
+@pytest.mark.parametrize("timing", ["step", "exact"])
+def test_tray_is_pyrefs_twin(tmp_path, timing):
+    """The tray's first 0.5 s (a grain pair through pair_style granular, three walls) within
+    round-off of pyref's, grain 1 held up."""
+    from stickslip import analysis
+
+    sc, dl = run_granular("tray", tmp_path, slip_timing=timing, duration=0.5)
+    assert_round_off_apart(sc, dl, pyref_case("tray", timing, duration=0.5), slips_where_pressed=True)
+    assert not analysis.summarise(sc, dl)["reached_bottom"]
+    assert dl["grain1-grain2_slip"].sum() > 10
+
+
+def test_one_and_two_ranks_are_identical(tmp_path):
+    """The tray's impact (its grain pair split between the ranks) and the tilt's start give
+    the same bits on 1 and 2 MPI ranks (each grain has at most one pair contact, so no sum
+    changes order)."""
+    for name, kw in (("tray", {"duration": 0.01}), ("tilt", {"duration": 0.005})):
+        _, d1 = run_granular(name, tmp_path / f"{name}1", **kw)
+        _, d2 = run_granular(name, tmp_path / f"{name}2", ranks=2, **kw)
+        assert d1.equals(d2), name
+        assert "on 2 procs" in (tmp_path / f"{name}2" / "lammps" / "log.lammps").read_text()
+
+
+def test_a_scene_with_rotation_says_where_the_lever_arm_differs(tmp_path):
+    """LAMMPS' granular model takes V_s with the radii as lever arms: a scene with rotation
+    gets a note saying so (the drum's first steps)."""
+    sc = scene_mod.load("drum_small", duration=0.002)
+    res = lammps_granular.run(sc, tmp_path)
+    assert any("lever arm" in n for n in res.notes)
+
+
+def test_a_tangential_dashpot_without_a_normal_one_is_refused(tmp_path):
+    """The granular model scales the tangential dashpot by the normal damping's prefactor:
+    nu_s > 0 with nu_n = 0 cannot be written, and the adapter says so in one line."""
+    sc = scene_mod.load("drag", duration=0.0001)
+    sc.effects["normal_damping"] = False
+    with pytest.raises(ValueError, match="nu_s > 0 needs nu_n > 0"):
+        lammps_granular.run(sc, tmp_path)
+
+
+@pytest.mark.parametrize("nu_s, nu_n", [(33.10, 41.38), (0.1, 0.3), (1.0, 3.0), (2.5e-3, 7.0)])
+def test_the_dashpot_ratio_gives_nu_s_to_the_last_bit(nu_s, nu_n):
+    x = lammps_granular.dashpot_ratio(nu_s, nu_n)
+    assert x * nu_n == nu_s
