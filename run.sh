@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # The two commands of the README, on a fresh Debian 12 machine:
 #   ./run.sh report   set up, then run every paper case on every engine -> report/report.md
 #   ./run.sh test     set up, then run the test suite
+#   ./run.sh wheel-check  set up, then build the wheel and run it installed outside the repository
 # Setup: Debian packages (when root; otherwise it says what to install), a Python
 # virtual environment in .venv with the project installed, the LIGGGHTS plugin, and the LAMMPS
 # plugin (with the LAMMPS headers it needs, taken from Debian's source package).
@@ -153,6 +155,68 @@ setup_lammps_2025() {
               -D BUILD_OMP=off -D CMAKE_BUILD_TYPE=Release >/dev/null
     fi
     cmake --build "$top/build" -j "$(nproc)" >/dev/null
+    # the legacy pair style gran/hooke/stickslip as a plugin of it (`plugin load`; lammps_plugin/
+    # lammps2025.cmake; ~10 s the first time on 2 cores, relinked when liblammps changes)
+    [ -f build/lammps_2025_plugin/CMakeCache.txt ] || \
+        cmake -S lammps_plugin -B build/lammps_2025_plugin -DCMAKE_BUILD_TYPE=Release \
+              -DLAMMPS_2025_DIR="$PWD/$top" >/dev/null
+    cmake --build build/lammps_2025_plugin -j "$(nproc)" >/dev/null
+}
+
+wheel_check() {
+    # Install without a clone: the sdist and wheel of `python -m build`, the wheel installed into
+    # a new virtual environment outside the repository, and pyref, calibrate and the YADE law
+    # run from it (tests/test_wheel.py: ~1 min on 2 cores, so ./run.sh test leaves it out)
+    .venv/bin/python -m pytest -q --runslow tests/test_wheel.py "$@"
+}
+
+setup_liggghts_public() {
+    # LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (6.5 MB, downloaded once), built as its users
+    # build it: liggghts_plugin/tangential_model_stick_slip.h copied into src/ and LIGGGHTS' own
+    # `make auto` (MPI with Debian 12's OpenMPI; VTK, JPG and superquadrics off, as none is needed
+    # and Debian's library has no superquadrics), with stick_slip compiled in for the 40
+    # combinations LIGGGHTS compiles for tangential history (src/style_contact_model_user.whitelist).
+    # Executable: build/liggghts_public/source/src/lmp_auto; 6.6 min on 2 cores (8 min of CPU),
+    # once. A changed header is copied again and make rebuilds what includes it (1.5 min);
+    # unchanged, a set-up costs nothing here. The source predates GNU make 4.3 and GCC 11: the
+    # four fixes below and MPI_LIB_USR in Makefile.user let Debian 12 build it.
+    wants_source_build liggghts-public || return 0
+    local top=build/liggghts_public version=3.8.0+repack1-9 src header=tangential_model_stick_slip.h
+    src=$top/source/src
+    if [ ! -f "$top/source/.complete" ]; then
+        echo "setup: LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (first time: ~7 min on 2 cores)"
+        fetch_debian_source bookworm liggghts "$version" "$top/download"
+        rm -rf "$top/source" && mkdir -p "$top/source"
+        tar -xJf "$top"/download/liggghts_*.orig.tar.xz -C "$top/source" --strip-components=1 \
+            --exclude='*/doc' --exclude='*/examples'
+        # GNU make >= 4.3 keeps the backslash of \# inside $(shell ...): Makefile.auto's probe
+        # programs would start with \#include (and OpenMPI be taken for MPICH)
+        sed -i 's/\\#/#/g' "$src/MAKE/Makefile.auto"
+        # GCC >= 11: a temporary stream cast to a reference; a pointer compared with 0 by >
+        sed -i 's/return static_cast< std::ostringstream & >(( std::ostringstream() << std::dec << a ) ).str();/std::ostringstream s; s << a; return s.str();/' "$src/utils.h"
+        sed -i 's/numneigh > 0) {/numneigh != NULL) {/' "$src/finish.cpp"
+        # the one VTK source without the LAMMPS_VTK guard of its siblings (else VTK is required)
+        for f in dump_mesh_vtk.h dump_mesh_vtk.cpp; do
+            { echo '#ifdef LAMMPS_VTK'; cat "$src/$f"; echo '#endif'; } > "$src/$f.new" && mv "$src/$f.new" "$src/$f"
+        done
+        # Makefile.user as `make auto` would write it, with the options above; OpenMPI's library
+        # folder given (without any -L, Makefile.auto links with an empty -Wl, that ld refuses)
+        tail -n +11 "$src/MAKE/Makefile.user_default" | sed -e 's/^USE_VTK = "ON"/USE_VTK = "OFF"/' \
+            -e 's/^USE_SUPERQUADRICS = "ON"/USE_SUPERQUADRICS = "OFF"/' \
+            -e "s|^#MPI_LIB_USR=.*|MPI_LIB_USR=$(mpicxx --showme:libdirs)|" > "$src/MAKE/Makefile.user"
+        cp "liggghts_plugin/$header" "$src/"
+        (cd "$src" && bash Make.sh models >/dev/null)
+        sed -n 's/TANGENTIAL_HISTORY/TANGENTIAL_STICK_SLIP/p' "$src/style_contact_model.whitelist" \
+            > "$src/style_contact_model_user.whitelist"
+        echo "$version" > "$top/source/.complete"
+    fi
+    cmp -s "liggghts_plugin/$header" "$src/$header" || { cp "liggghts_plugin/$header" "$src/"; rm -f "$src/lmp_auto"; }
+    [ -x "$src/lmp_auto" ] && return 0
+    (cd "$src" && make auto -j "$(nproc)" >../../make.log 2>&1) || {
+        echo "setup: LIGGGHTS' make auto failed (build/liggghts_public/make.log):" >&2
+        grep -m 5 -E 'error:|\*\*\*' "$top/make.log" >&2
+        return 1
+    }
 }
 
 setup() {
@@ -161,6 +225,7 @@ setup() {
     setup_plugin
     setup_lammps_plugin
     setup_lammps_2025
+    setup_liggghts_public
 }
 
 case "${1:-}" in
@@ -182,11 +247,16 @@ case "${1:-}" in
         [ "$workers" -gt 16 ] && workers=16
         .venv/bin/python -m pytest -q -n "${STICKSLIP_TEST_JOBS:-$workers}" --dist worksteal "$@"
         ;;
+    wheel-check)
+        setup
+        shift
+        wheel_check "$@"
+        ;;
     setup)
         setup
         ;;
     *)
-        echo "usage: ./run.sh report|test|setup [extra arguments]" >&2
+        echo "usage: ./run.sh report|test|wheel-check|setup [extra arguments]" >&2
         exit 2
         ;;
 esac

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-2.0-or-later
 // stickslip: the stick-slip tangential contact law of Khellaf & Mansouri (2024) as a
 // DEM-Engine (PyPI `deme` 3.0) custom force model: this text is the body DEM-Engine
 // compiles into its force kernels (DefineContactForceModel), step by step as docs/law.md

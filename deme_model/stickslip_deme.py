@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The stick-slip law on DEM-Engine (PyPI `deme`): attach deme_model/stick_slip.cu to a solver.
 
     import sys; sys.path.insert(0, "/path/to/deme_model")
@@ -18,8 +19,14 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+__version__ = "1.0.0"  # the project's version, pyproject.toml's (tests/test_release.py checks they agree)
+
 HERE = Path(__file__).resolve().parent
+# beside this file in the repository (deme_model/); a wheel installs this module among the
+# installed packages and the model as the stickslip package's data
 MODEL_FILE = HERE / "stick_slip.cu"
+if not MODEL_FILE.is_file():
+    MODEL_FILE = HERE / "stickslip" / "data" / "deme_model" / "stick_slip.cu"
 
 NORMALS = ("hertz", "hooke")
 # the spring D (3) and the steps that slipped since the contact began

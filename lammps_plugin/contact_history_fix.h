@@ -1,4 +1,5 @@
-/* The pair style's contact history fix: stock FixNeighHistory (same ID, same style name
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   The pair style's contact history fix: stock FixNeighHistory (same ID, same style name
    NEIGH_HISTORY, so restart files are stock's and interchangeable), except that
    write_restart outside a run saves the contact history that the end of the last run
    stored with the atoms, instead of storing it again from the neighbour list.

@@ -1,4 +1,5 @@
-/* fix ID group wall/gran/region/stickslip hooke/history Kn Kt gamma_n gamma_t xmu dampflag
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   fix ID group wall/gran/region/stickslip hooke/history Kn Kt gamma_n gamma_t xmu dampflag
        [limit_damping] region regionID [contacts] [keyword value ...]
 
    Stock wall/gran/region (its arguments, its region look-up, the region's motion in restart

@@ -1,4 +1,5 @@
-/* fix ID group wall/gran/stickslip hooke/history Kn Kt gamma_n gamma_t xmu dampflag
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   fix ID group wall/gran/stickslip hooke/history Kn Kt gamma_n gamma_t xmu dampflag
        [limit_damping] wallstyle args [wiggle|shear ...] [contacts] [keyword value ...]
 
    Stock wall/gran with its primitive walls (xplane, yplane, zplane, zcylinder) and motion

@@ -1,4 +1,5 @@
-/* pair_style gran/hooke/stickslip Kn Kt gamma_n gamma_t xmu dampflag [limit_damping] [keyword value ...]
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   pair_style gran/hooke/stickslip Kn Kt gamma_n gamma_t xmu dampflag [limit_damping] [keyword value ...]
 
    Stock gran/hooke/history's arguments with their meaning (xmu is mu_s); the tangential
    force is the stick-slip law (stick_slip_law.h). The normal force, the relative
@@ -202,7 +203,11 @@ void PairGranHookeStickSlip::compute(int eflag, int vflag)
   // rigid bodies: a grain of a rigid body moves with the body's mass (stock)
   if (fix_rigid && neighbor->ago == 0) {
     StickSlip::refresh_rigid_mass(lmp, fix_rigid, mass_rigid, nmax, "pair:mass_rigid");
+#if STICKSLIP_MODERN_LAMMPS
+    comm->forward_comm(this);
+#else
     comm->forward_comm_pair(this);
+#endif
   }
 
   // the contact loop compiled for this combination of the law's settings, and for a step
@@ -239,6 +244,10 @@ template <class Mode, bool STEPPING> void PairGranHookeStickSlip::contacts()
   const int newton_pair = force->newton_pair;
   const bool tally = evflag;
   constexpr int dnum = Mode::record(Settings()) ? SIZE_RECORD : SIZE_PLAIN;
+  // bonded grains: LAMMPS 2023 and later weigh each pair's force and torque by special_lj, as
+  // stock does there (lammps_api.h); before, every pair counts fully (1: no code)
+  constexpr bool special_weights = STICKSLIP_MODERN_LAMMPS;
+  const double *special_lj = force->special_lj;
 
   const int inum = list->inum;
   const int *ilist = list->ilist, *numneigh = list->numneigh;
@@ -257,6 +266,8 @@ template <class Mode, bool STEPPING> void PairGranHookeStickSlip::contacts()
     const Coeffs *coeffs_i = pair_coeffs[type[i]];
 
     for (int jj = 0; jj < jnum; jj++) {
+      const double factor = special_weights ? special_lj[sbmask(jlist[jj])] : 1.0;
+      if (factor == 0.0) continue;  // (stock: the pair is skipped, its history kept)
       const int j = jlist[jj] & NEIGHMASK;
       const double del[3] = {xi - x[j][0], yi - x[j][1], zi - x[j][2]};
       const double rsq = del[0] * del[0] + del[1] * del[1] + del[2] * del[2];
@@ -315,13 +326,14 @@ template <class Mode, bool STEPPING> void PairGranHookeStickSlip::contacts()
                              fs);
 
       // forces and torques (docs/law.md step 6)
-      const double fx = del[0] * ccel + fs[0], fy = del[1] * ccel + fs[1], fz = del[2] * ccel + fs[2];
+      const double fx = (del[0] * ccel + fs[0]) * factor, fy = (del[1] * ccel + fs[1]) * factor,
+                   fz = (del[2] * ccel + fs[2]) * factor;
       f[i][0] += fx;
       f[i][1] += fy;
       f[i][2] += fz;
-      const double tor1 = rinv * (del[1] * fs[2] - del[2] * fs[1]);
-      const double tor2 = rinv * (del[2] * fs[0] - del[0] * fs[2]);
-      const double tor3 = rinv * (del[0] * fs[1] - del[1] * fs[0]);
+      const double tor1 = rinv * (del[1] * fs[2] - del[2] * fs[1]) * factor;
+      const double tor2 = rinv * (del[2] * fs[0] - del[0] * fs[2]) * factor;
+      const double tor3 = rinv * (del[0] * fs[1] - del[1] * fs[0]) * factor;
       torque[i][0] -= ci * tor1;
       torque[i][1] -= ci * tor2;
       torque[i][2] -= ci * tor3;
@@ -451,7 +463,11 @@ double *PairGranHookeStickSlip::find_history(int i, int j, double &sign) const
 
 /* The history seen from the other body (record only; stock negates every value): D and
    the tangential force change sign, Fn, the slip count and the work do not. */
+#if STICKSLIP_MODERN_LAMMPS
+void PairGranHookeStickSlip::transfer_history(double *source, double *target, int, int)
+#else
 void PairGranHookeStickSlip::transfer_history(double *source, double *target)
+#endif
 {
   for (int m = 0; m < size_history; m++) target[m] = source[m];
   for (int k = 0; k < 3; k++) {

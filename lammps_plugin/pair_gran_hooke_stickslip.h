@@ -1,10 +1,12 @@
-/* pair_style gran/hooke/stickslip: stock gran/hooke/history's arguments and meaning,
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   pair_style gran/hooke/stickslip: stock gran/hooke/history's arguments and meaning,
    with the stick-slip law (stick_slip_law.h) for the tangential force.
    Syntax and keywords: lammps_plugin/README.md. */
 
 #ifndef STICKSLIP_PAIR_GRAN_HOOKE_STICKSLIP_H
 #define STICKSLIP_PAIR_GRAN_HOOKE_STICKSLIP_H
 
+#include "lammps_api.h"
 #include "pair_gran_hooke_history.h"
 #include "stick_slip_law.h"
 
@@ -26,7 +28,11 @@ class PairGranHookeStickSlip : public LAMMPS_NS::PairGranHookeHistory {
   void write_restart_settings(FILE *) override;
   void read_restart_settings(FILE *) override;
   double single(int, int, int, int, double, double, double, double &) override;
+#if STICKSLIP_MODERN_LAMMPS
+  void transfer_history(double *, double *, int, int) override;
+#else
   void transfer_history(double *, double *) override;
+#endif
 
  protected:
   Settings law;

@@ -1,4 +1,5 @@
-/* Makes gran/hooke/stickslip and wall/gran/stickslip styles of the installed LAMMPS, which
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   Makes gran/hooke/stickslip and wall/gran/stickslip styles of the installed LAMMPS, which
    has no PLUGIN package and cannot be rebuilt here.
 
    LAMMPS creates styles through name -> creator maps (Force::pair_map, Modify::fix_map),
@@ -10,15 +11,19 @@
    then on every map LAMMPS builds has them: at start-up (the launcher, LD_PRELOAD), after
    `clear`, and before `read_restart`. An instance that exists already when the library is
    loaded (the stock lmp with stickslip.lmp, the python module) gets them from
-   stickslip_lammps_register(). */
+   stickslip_lammps_register(), which also prints the plugin's version (the launcher
+   lmp-stickslip prints it itself). */
 
 #include "fix_wall_gran_region_stickslip.h"
 #include "fix_wall_gran_stickslip.h"
 #include "pair_gran_hooke_stickslip.h"
 
+#include "comm.h"
 #include "force.h"
 #include "lammps.h"
 #include "modify.h"
+#include "stickslip_version.h"
+#include "utils.h"
 
 #include <cstring>
 #include <link.h>
@@ -154,5 +159,8 @@ extern "C" __attribute__((visibility("default"))) int stickslip_lammps_register(
   LAMMPS *lmp = static_cast<LAMMPS *>(lammps);
   add_styles(lmp->force);
   add_styles(lmp->modify);
+  if (lmp->comm->me == 0)
+    utils::logmesg(lmp, "stickslip " STICKSLIP_VERSION ": gran/hooke/stickslip, wall/gran/stickslip, "
+                        "wall/gran/region/stickslip (Khellaf & Mansouri 2024)\n");
   return npatched == NENTRIES ? 0 : 1;
 }

@@ -1,4 +1,5 @@
-/* Grains of a rigid body collide with the body's mass (the stock granular styles' rule for
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   Grains of a rigid body collide with the body's mass (the stock granular styles' rule for
    the normal damping's effective mass). At each neighbour-list build the pair style and
    both walls refresh, for each owned grain, its body's mass (0: in no body) from the rigid
    fix's "body" and "masstotal". */

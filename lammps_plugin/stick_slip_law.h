@@ -1,4 +1,5 @@
-/* stickslip: the stick-slip tangential contact law of Khellaf & Mansouri (2024) on LAMMPS.
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   stickslip: the stick-slip tangential contact law of Khellaf & Mansouri (2024) on LAMMPS.
 
    This file is the only place the law lives on LAMMPS (the pair style and the walls call
    it); it follows docs/law.md step by step, with the branch order and constants of

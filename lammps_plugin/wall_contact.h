@@ -1,4 +1,5 @@
-/* One grain-wall contact of a Hookean granular wall with the stick-slip law: the normal
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   One grain-wall contact of a Hookean granular wall with the stick-slip law: the normal
    force and relative velocity of stock wall/gran hooke/history (same operations in the
    same order), the tangential force from stick_slip_law.h. Used by fix
    wall/gran/stickslip; written so that a region wall (wall/gran/region/stickslip) can

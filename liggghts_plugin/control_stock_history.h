@@ -1,4 +1,5 @@
-/* A control for the overhead benchmark (issue 32), never the shipped model: built with
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   A control for the overhead benchmark (issue 32), never the shipped model: built with
    -DSTICK_SLIP_CONTROL_STOCK, `tangential stick_slip` runs LIGGGHTS' own `tangential
    history` (its class from Debian's header, unchanged), compiled into this plugin as the
    law is. Timed against the stock model in Debian's library, it shows what the plugin's

@@ -1,4 +1,5 @@
-/* Compiles and registers a share of the pair and wall styles of stick_slip: the
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   Compiles and registers a share of the pair and wall styles of stick_slip: the
    combinations listed in stick_slip_combinations.h (generated from the library's own
    `tangential history` combinations) whose place in the list is STICK_SLIP_PART modulo
    STICK_SLIP_PARTS. CMakeLists.txt builds this file once per part, so that the

@@ -1,4 +1,5 @@
-/* Registers `tangential stick_slip` with the installed LIGGGHTS library when this
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   Registers `tangential stick_slip` with the installed LIGGGHTS library when this
    shared object is loaded (static initializer): the model name, and one pair style and
    one wall style for every combination of surface, normal, cohesion and rolling model
    that the library itself offers with stock `tangential history`. That list is read

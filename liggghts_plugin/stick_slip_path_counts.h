@@ -1,9 +1,12 @@
-/* stickslip: counts of the paths through tangential stick_slip, for the cost analysis of
-   issue 32 (where a contact-step's time goes). Off in the default build: STICK_SLIP_COUNT
-   is then nothing. Built with `cmake -DSTICK_SLIP_PATH_COUNTS=ON` (a separate build
-   directory; stickslip/bench/liggghts_paths.py does it), every path taken by an evaluation
-   that updates the history adds one to its counter, and the counts are written when the program ends, one "name count" line
-   each, to the file named by the environment variable STICK_SLIP_PATH_COUNTS (else stderr). */
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   stickslip: counts of the paths through tangential stick_slip, for the cost analysis of
+   issue 32 (where a contact-step's time goes). Off in the default build: the law's header
+   then leaves this file out and defines STICK_SLIP_COUNT as nothing. Built with
+   `cmake -DSTICK_SLIP_PATH_COUNTS=ON` (a separate build directory;
+   stickslip/bench/liggghts_paths.py does it), every path taken by an evaluation that updates
+   the history adds one to its counter, and the counts are written when the program ends, one
+   "name count" line each, to the file named by the environment variable
+   STICK_SLIP_PATH_COUNTS (else stderr). */
 
 #ifndef STICK_SLIP_PATH_COUNTS_H_
 #define STICK_SLIP_PATH_COUNTS_H_
@@ -73,9 +76,6 @@ inline Report report;
 #define STICK_SLIP_COUNT(path) \
   (LIGGGHTS::ContactModels::StickSlipPaths::counts[LIGGGHTS::ContactModels::StickSlipPaths::path] += \
    LIGGGHTS::ContactModels::StickSlipPaths::counting)
-#else
-#define STICK_SLIP_COUNTING(on) ((void)0)
-#define STICK_SLIP_COUNT(path) ((void)0)
 #endif
 
 #endif

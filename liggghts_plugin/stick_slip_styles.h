@@ -1,4 +1,5 @@
-/* The pair and wall styles of `tangential stick_slip`: LIGGGHTS' own granular pair style
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   The pair and wall styles of `tangential stick_slip`: LIGGGHTS' own granular pair style
    and wall templates, with the contact-model settings checked (and two keywords of this
    model translated) before LIGGGHTS parses them. */
 

@@ -1,9 +1,13 @@
-/* stickslip: the stick-slip tangential contact law of Khellaf & Mansouri (2024)
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   stickslip: the stick-slip tangential contact law of Khellaf & Mansouri (2024)
    as a LIGGGHTS 3.8 tangential model, `tangential stick_slip`.
 
    This file is the only place the law lives on LIGGGHTS; it follows
    docs/law.md (the contract shared with pyref and the YADE law) step by step.
-   Built as a plugin against the installed Debian headers (see CMakeLists.txt). */
+   Built two ways from this one file: as a plugin against the installed Debian headers
+   (CMakeLists.txt, which registers the model itself), or dropped alone into LIGGGHTS'
+   src/ and built with `make auto`, whose style scan registers it as LIGGGHTS' own
+   tangential models (doc/tangential_model_stick_slip.md, "Build into LIGGGHTS"). */
 
 #ifdef TANGENTIAL_MODEL
 // id 23: unused by LIGGGHTS 3.8 (off 0, no_history 1, history 2, tan_luding 4); ids must be < 64
@@ -22,7 +26,14 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 #include "neighbor.h"
 #include "atom.h"
 #include "fix_property_atom.h"
+// the plugin's analysis build counts the law's paths; otherwise (and in LIGGGHTS' own
+// build, which has no stick_slip_path_counts.h) the counts compile to nothing
+#ifdef STICK_SLIP_PATH_COUNTS
 #include "stick_slip_path_counts.h"
+#else
+#define STICK_SLIP_COUNTING(on) ((void)0)
+#define STICK_SLIP_COUNT(path) ((void)0)
+#endif
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """pyref: the standalone reference solver (numpy) the engines are checked against."""
 from .laws import LawParams, TangentialStep, normal_force, tangential_force
 from .solver import ENERGY_FIELDS, Contacts, Recording, Simulation

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The contact laws of Khellaf & Mansouri (2024), vectorised over contacts.
 
 This is the one numpy kernel of the law: pyref and the YADE law both call it

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """pyref: a small reference DEM solver for disks (2D) and spheres (3D) on plane walls.
 
 Newton's law (eq. 1) is integrated by velocity Verlet, the scheme LIGGGHTS uses
@@ -7,13 +8,13 @@ scene switches on are computed (gravity, rotation, damping, moving walls).
 """
 from __future__ import annotations
 
-import math
 import time
 from typing import NamedTuple
 
 import numpy as np
 
 from .laws import _count_nonzero, _dot, normal_force, rotate_history, tangential_force
+from .vectors import ZERO, Rotation, all_finite, cross, scatter
 
 PAIR_BRUTE_FORCE_MAX = 64  # below this many grains, test every pair (no tree)
 
@@ -131,7 +132,7 @@ class Simulation:
         # Walls whose velocities are all +0 stay at p0 + 0 (what p0 + v*t*dt gives then).
         self.walls_translate = bool(self.wall_v.any() or np.signbit(self.wall_v).any())
         self.wall_p_still = self.wall_p0 + 0.0
-        self.wall_turn = [_Rotation(w.rotation.axis) if w.rotation else None for w in s.walls]
+        self.wall_turn = [Rotation(w.rotation.axis) if w.rotation else None for w in s.walls]
         self.step_no = 0
 
         # Contact state, kept sorted by key = i*(N+W) + j, j = grain index or N + wall.
@@ -186,10 +187,10 @@ class Simulation:
         for k in rates.nonzero()[0]:
             rot = self.walls[k].rotation
             if self.W == 1:  # every row is this wall's (the same sums as selecting them all)
-                vw += rates[k] * _cross(rot.axis[None, :], cp - rot.pivot)
+                vw += rates[k] * cross(rot.axis[None, :], cp - rot.pivot)
                 continue
             sel = wk == k
-            vw[sel] += rates[k] * _cross(rot.axis[None, :], cp[sel] - rot.pivot)  # (the axis row broadcasts)
+            vw[sel] += rates[k] * cross(rot.axis[None, :], cp[sel] - rot.pivot)  # (the axis row broadcasts)
         return vw
 
     def wall_angle(self, k):
@@ -234,11 +235,11 @@ class Simulation:
             d = x.take(b, 0) - x.take(a, 0)
             dist = np.sqrt(_dot(d, d))
             delta_p = reach - dist
-            pair_hit = delta_p > _ZERO
+            pair_hit = delta_p > ZERO
         if self.W:
             p, n, rates, offset = self._wall_state()
             delta_w = self.r_walls - (x @ n.T - offset)
-            wall_hit = delta_w > _ZERO
+            wall_hit = delta_w > ZERO
         # Which contacts touch rarely changes from one step to the next: the rows' indices
         # and keys are rebuilt only when it does.
         sig = (None if pair_hit is None else pair_hit.tobytes(), None if wall_hit is None else wall_hit.tobytes())
@@ -316,7 +317,7 @@ class Simulation:
             c_i = self.r.take(i) - 0.5 * delta
             c_j = np.where(grain_j, self.r.take(j_grain) - 0.5 * delta, 0.0)
             w_j = np.where(grain_j[:, None], self.w.take(j_grain, 0), 0.0)
-            v_rel = v_rel + _cross(c_i[:, None] * self.w.take(i, 0) + c_j[:, None] * w_j, n)
+            v_rel = v_rel + cross(c_i[:, None] * self.w.take(i, 0) + c_j[:, None] * w_j, n)
         v_n = _dot(v_rel, n)
         V_s = v_rel - v_n[:, None] * n  # eq. 6
         fn = normal_force(delta, v_n, self.p)  # eq. 3
@@ -354,12 +355,12 @@ class Simulation:
         np.add(-fn[:, None] * n, F_s, out=F[:K])
         np.negative(F[:P], out=F[K:])
         on = self._layout.on_flat
-        f = _scatter(on, F, N)
+        f = scatter(on, F, N)
         torque = None
         if self.rotation_on:
             # Torques (c_i n) x F_s on i and (-c_j n) x (-F_s) = c_j (n x F_s) on j.
-            c = _cross(n, F_s)
-            torque = _scatter(on, np.concatenate((c_i[:, None] * c, c_j[:P, None] * c[:P])) if P else c_i[:, None] * c,
+            c = cross(n, F_s)
+            torque = scatter(on, np.concatenate((c_i[:, None] * c, c_j[:P, None] * c[:P])) if P else c_i[:, None] * c,
                               N)
         if self.gravity_on:
             if self.turning_gravity:  # the gravity of the time the positions belong to
@@ -555,53 +556,9 @@ class Simulation:
                     self.record_row()
             if progress is not None and k % 2000 == 0:
                 progress(k, steps)
-            if not (_all_finite(self.x) and _all_finite(self.v)):
+            if not (all_finite(self.x) and all_finite(self.v)):
                 raise FloatingPointError(f"non-finite position or velocity at step {self.step_no} "
                                          f"(t = {self.step_no * self.dt:g} s)")
         if progress is not None:
             progress(steps, steps)
         return self.recording(steps, time.perf_counter() - t0)
-
-
-_ZERO = np.zeros(())  # numpy compares with a 0-d array faster than with the float 0.0
-
-# Component k of a x b is a[k+1] b[k+2] - a[k+2] b[k+1] (indices mod 3).
-_NEXT, _AFTER_NEXT = np.array([1, 2, 0]), np.array([2, 0, 1])
-
-
-def _cross(a, b):
-    """Row-wise cross product of (K, 3) arrays (np.cross, without its axis juggling);
-    `a` may be a single row, broadcast over b's."""
-    return a.take(_NEXT, 1) * b.take(_AFTER_NEXT, 1) - a.take(_AFTER_NEXT, 1) * b.take(_NEXT, 1)
-
-
-def _all_finite(a):
-    """np.isfinite(a).all(), faster on a few grains."""
-    return _count_nonzero(np.isfinite(a)) == a.size
-
-
-def _scatter(flat, values, n):
-    """Sum the rows of `values` (K, 3) into n rows, component k of row r going to flat
-    place flat[3r + k], in the rows' order from zero (np.bincount adds in that order,
-    as np.add.at does, and is faster even on a few rows)."""
-    if not len(flat):
-        return np.zeros((n, 3))  # (np.bincount would give integers)
-    return np.bincount(flat, values.ravel(), 3 * n).reshape(n, 3)
-
-
-class _Rotation:
-    """Rotations about one fixed unit axis, by Rodrigues' formula; the last matrix is
-    kept (a wall that has stopped turning asks for the same angle every step)."""
-
-    def __init__(self, axis):
-        k = np.asarray(axis, float)
-        self.K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-        self.I = np.eye(3)
-        self.angle, self.R = None, None
-
-    def matrix(self, angle):
-        """R = I + sin(angle) K + (1 - cos(angle)) K K (Rodrigues' formula)."""
-        if angle != self.angle:
-            K = self.K
-            self.angle, self.R = angle, self.I + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
-        return self.R

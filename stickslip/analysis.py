@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Headline figures of a run, computed from the standard time series alone.
 
 The same code reads every engine's output, so engines are compared on equal terms:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The `stickslip` command: parses its arguments and calls the module that does the work.
 
 run -> runner.py, report -> report.py, bench -> bench/table.py, precision, thresholds,
@@ -15,8 +16,9 @@ import os
 import sys
 from pathlib import Path
 
+from . import __version__
 from . import scene as scene_mod
-from .adapters import ENGINES, OPTIONAL_ENGINES
+from .adapters import ENGINES, OPTIONAL_ENGINES, SOURCE_BUILT
 from .errors import EngineError, SceneError
 
 
@@ -28,34 +30,36 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(2)
 
 
-def _positive(text):
+def _number(text, kind, ok, allowed):
+    """`text` as a `kind` (float or int) for which ok(v) holds, else argparse's one-line error
+    naming what is allowed."""
     try:
-        v = float(text)
+        v = kind(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not (v > 0 and math.isfinite(v)):
-        raise argparse.ArgumentTypeError(f"{text!r} must be a finite number > 0")
+        raise argparse.ArgumentTypeError(f"{text!r} is not a {'whole number' if kind is int else 'number'}") from None
+    if not ok(v):
+        raise argparse.ArgumentTypeError(f"{text!r} must be {allowed}")
     return v
+
+
+def _positive(text):
+    return _number(text, float, lambda v: v > 0 and math.isfinite(v), "a finite number > 0")
 
 
 def _count(text):
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if not 1 <= v <= 100:
-        raise argparse.ArgumentTypeError(f"{text!r} must be in [1, 100]")
-    return v
+    return _number(text, int, lambda v: 1 <= v <= 100, "in [1, 100]")
 
 
 def _angle(text):
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not 0 < v < 90:
-        raise argparse.ArgumentTypeError(f"{text!r} must be an angle in degrees, in (0, 90)")
-    return v
+    return _number(text, float, lambda v: 0 < v < 90, "an angle in degrees, in (0, 90)")
+
+
+def _nonnegative(text):
+    return _number(text, float, lambda v: 0 <= v < 90, "a standard error in [0, 90)")
+
+
+def _share(text):
+    return _number(text, float, lambda v: 0 < v < 1, "in (0, 1)")
 
 
 def _folder(text):
@@ -67,6 +71,7 @@ def _folder(text):
 
 def build_parser():
     p = _Parser(prog="stickslip", description="Stick-slip friction (Khellaf & Mansouri 2024) on DEM engines.")
+    p.add_argument("--version", action="version", version=f"stickslip {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     r = sub.add_parser("run", help="run one scene on one engine")
@@ -133,8 +138,8 @@ def build_parser():
     de.add_argument("--out", type=_folder, default=Path("docs/drum"), help="tables and figures (default: docs/drum)")
     de.add_argument("--runs", type=_folder, default=Path("runs/drum_study"),
                     help="the runs, kept for resuming (default: runs/drum_study)")
-    de.add_argument("--engines", nargs="+", choices=ENGINES, default=list(ENGINES),
-                    help="engines to compare (default: all)")
+    de.add_argument("--engines", nargs="+", choices=ENGINES, default=[e for e in ENGINES if e not in SOURCE_BUILT],
+                    help="engines to compare (default: all but those built from source)")
     de.add_argument("--duration", type=_positive, default=40.0,
                     help="simulated time of the statistics runs, s (default: 40)")
     de.add_argument("--parts", nargs="+", choices=("costs", "divergence", "statistics"),
@@ -149,6 +154,10 @@ def build_parser():
                     help="the runs, kept for resuming (default: runs/granular3d)")
     g3.add_argument("--fills", type=_count, default=3, help="fills (random beds) per point (default: 3)")
     g3.add_argument("--only", nargs="+", help="run only the runs whose label holds one of these strings")
+    g3.add_argument("--groups", nargs="+", choices=("sweep", "validation", "check", "engines", "coverage", "shear"),
+                    default=["sweep", "validation", "check", "engines", "coverage", "shear"],
+                    help="run only these groups of the study: the map (sweep), the validation, its checks, LAMMPS "
+                         "(engines), calibrate's round trip (coverage), the sheared layer (shear); default: all")
     g3.add_argument("--no-checks", action="store_true", help="leave out the check with Silbert et al.'s stiffer "
                                                               "contact (~1 CPU hour)")
     g3.add_argument("--engines", nargs="+", choices=("liggghts", "lammps"), default=["liggghts", "lammps"],
@@ -166,6 +175,16 @@ def build_parser():
     cal.add_argument("--theta-start", type=_angle, help="angle at which a bed starts to flow, deg")
     cal.add_argument("--theta-stop", type=_angle, help="angle at which a flowing bed stops, deg")
     cal.add_argument("--theta-heap", type=_angle, help="angle of repose of a heap on a plate, deg")
+    cal.add_argument("--shear-drop", type=_share, help="mean stress drop of a sheared layer's slips over the normal "
+                                                       "stress (kind shear3d; needs a map that measured it)")
+    for name in ("theta-start", "theta-stop", "theta-heap", "shear-drop"):
+        cal.add_argument(f"--{name}-se", type=_nonnegative, help=f"standard error of --{name} (default 0: exact)")
+    cal.add_argument("--measurements", type=Path, help="CSV of repeated measurements: a column per target "
+                                                       "(theta_start, theta_stop, theta_heap, shear_drop), a row per "
+                                                       "repeat, n >= 2; mean and standard error from them")
+    cal.add_argument("--interpolation", choices=("auto", "linear", "quadratic"), default="auto",
+                     help="the map's interpolation (default auto: the one of smaller leave-one-out error)")
+    cal.add_argument("--region-png", type=Path, help="draw the answer's chi2 region on the map (PNG)")
     cal.add_argument("--rolling", type=float, default=0.0, help="rolling resistance coefficient (epsd2) of the "
                                                                  "material (default: 0)")
     cal.add_argument("--map", type=Path, help="the measured map, points.csv (default: docs/granular-3d/points.csv)")
@@ -303,7 +322,7 @@ def cmd_study_3d(args):
     granular3d.run_study(args.out, args.runs, fills=tuple(range(1, args.fills + 1)), checks=not args.no_checks,
                          engines=tuple(args.engines), only=args.only, jobs_at_once=args.jobs,
                          progress=not args.quiet, tables_only=args.tables_only,
-                         keep_engine_files=args.keep_engine_files, **smoke)
+                         keep_engine_files=args.keep_engine_files, groups=tuple(args.groups), **smoke)
     return 0
 
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The time-series columns every engine writes (docs/adapters.md): the names live here only.
 
 `names(scene)` is the full header, in order; it needs nothing but the standard library,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The two errors a user can get from stickslip, each a one-line message."""
 
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Independent runs on every core, with one progress bar.
 
 A task is (cost, function, args): a module-level function and picklable arguments;

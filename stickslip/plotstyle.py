@@ -1,7 +1,14 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """What every report figure shares: one line style per engine, and saving a figure."""
 from __future__ import annotations
 
-ENGINE_LINES = {"pyref": "-", "liggghts": "--", "yade": ":", "lammps": "-."}
+ENGINE_LINES = {"pyref": "-", "liggghts": "--", "yade": ":", "lammps": "-.", "lammps_granular": (0, (5, 2, 1, 2, 1, 2)),
+                "deme": (0, (1, 3))}
+
+
+def line(engine):
+    """An engine's line in the figures that overlay engines (keyword arguments of plot)."""
+    return {"linestyle": ENGINE_LINES[engine]}
 
 
 def pyplot():

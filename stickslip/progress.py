@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """A progress bar for long runs (tqdm on stderr), or nothing when disabled."""
 from __future__ import annotations
 

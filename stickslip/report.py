@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`stickslip report`: the paper's three cases on every available engine.
 
 Each case's kind (stickslip/kinds/) gives its figures (the paper's Figs. 9, 11, 12, 14

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Run a scene on an engine and write its results: the one place a run flows through.
 
 scene (checked) -> adapter.run -> time series (stickslip/columns.py), checked finite
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import adapters, analysis, columns
+from . import __version__, adapters, analysis, columns
 from . import scene as scene_mod
 from .errors import EngineError, SceneError
 from .progress import bar
@@ -27,7 +28,7 @@ from .scene import load as scene_load
 ANNOUNCE_GRAIN_STEPS = 1e8
 ANNOUNCE_RECORDED = 1e8
 # engines whose adapter runs a scene on several MPI processes (run(..., np_ranks=N))
-MPI_ENGINES = ("liggghts", "lammps")
+MPI_ENGINES = ("liggghts", "lammps", "lammps_granular")
 
 
 def prepare_output(out_dir) -> Path:
@@ -56,7 +57,7 @@ def run_scene(scene, engine, out_dir, progress=True, ranks=1, write_timeseries=T
     drum run's CSV is gigabytes and takes longer to write than to reduce)."""
     adapter = adapters.get(engine)
     if ranks > 1 and engine not in MPI_ENGINES:
-        raise SceneError(f"--ranks {ranks}: only {' and '.join(MPI_ENGINES)} run on several MPI processes "
+        raise SceneError(f"--ranks {ranks}: only {', '.join(MPI_ENGINES)} run on several MPI processes "
                          f"(engine {engine}: 1)")
     reason = adapter.available()
     if reason is not None:
@@ -83,8 +84,9 @@ def run_scene(scene, engine, out_dir, progress=True, ranks=1, write_timeseries=T
     if write_timeseries:
         _write(out_dir / "timeseries.csv", lambda p: df.to_csv(p, index=False))
     summary = {
-        "scene": scene.name, "engine": engine, "law": scene.contact.law, "reset": scene.contact.reset,
-        "slip_timing": scene.contact.slip_timing, "dt_s": scene.dt, "steps": int(result.steps),
+        "scene": scene.name, "engine": engine, "version": __version__, "law": scene.contact.law,
+        "reset": scene.contact.reset, "slip_timing": scene.contact.slip_timing, "dt_s": scene.dt,
+        "steps": int(result.steps),
         "wall_time_s": float(result.wall_time_s), "ranks": ranks, "dimension": scene.dimension, "effects": scene.effects,
     }
     summary.update(analysis.summarise(scene, df))
@@ -120,9 +122,9 @@ def _one_line(e):
 # engine, only to run the longest jobs first (stickslip/parallel.py). On the paper's
 # small scenes a step costs about the same whatever the grains (pyref: numpy's per-call
 # overhead; YADE: its Python law), so the part per step dominates there.
-_STEP = {"pyref": 5e-5, "liggghts": 2e-6, "yade": 2.5e-4, "lammps": 5e-6}
-_PER_OBJECT = {"pyref": 1e-6, "liggghts": 3e-7, "yade": 5e-6, "lammps": 3e-7}
-_START = {"pyref": 0.0, "liggghts": 0.5, "yade": 1.5, "lammps": 0.5}
+_STEP = {"pyref": 5e-5, "liggghts": 2e-6, "yade": 2.5e-4, "lammps": 5e-6, "lammps_granular": 5e-6}
+_PER_OBJECT = {"pyref": 1e-6, "liggghts": 3e-7, "yade": 5e-6, "lammps": 3e-7, "lammps_granular": 3e-7}
+_START = {"pyref": 0.0, "liggghts": 0.5, "yade": 1.5, "lammps": 0.5, "lammps_granular": 0.5}
 
 
 def cost(scene, engine, steps=None) -> float:

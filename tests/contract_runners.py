@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """One function per engine that runs a case of tests/law_contract.py and returns what its
 contact recorded at the end of each step: {"fn": (N,), "F": (N, 3) force on i,
 "D": (N, 3) spring, "slips": (N,) steps that slipped since the contact began,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """DEM-Engine's force model (deme_model/stick_slip.cu) on the CPU: the shim library and a runner
 of the law's contract (tests/law_contract.py) through it.
 

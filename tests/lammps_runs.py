@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Running Debian's LAMMPS and the stick-slip plugin (lammps_plugin/) from the tests.
 
 The plugin's build (`./run.sh setup`): build/lammps_plugin/ holds the launcher

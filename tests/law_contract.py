@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The law's contract (docs/law.md) as a table of one-contact cases, the same on every engine.
 
 Each case holds one contact still (positions and velocities prescribed, nothing

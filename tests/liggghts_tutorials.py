@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Variants of the LIGGGHTS tutorials that Debian ships (package liggghts-doc), derived at
 test time: the scripts are read from the installed package, never copied into the
 repository.

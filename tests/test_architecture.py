@@ -1,4 +1,5 @@
-"""The package's shape (issue 14): no import circles, one home per idea."""
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The package's shape: no import circles, one home per idea, no module too long to read."""
 import ast
 from pathlib import Path
 
@@ -89,13 +90,15 @@ def test_case_kinds_are_only_named_in_their_modules():
 
 def test_adapters_know_only_their_engine_and_the_time_series_columns():
     """stickslip/adapters/ holds the adapters and their dump readers: no case kind, study,
-    benchmark, report or runner is known there (the runner calls them, not the reverse)."""
+    benchmark, report or runner is known there (the runner calls them, not the reverse).
+    stickslip.shipped (where the engines' files are, in a checkout or a wheel) knows nothing."""
     g = graph()
     adapters = [n for n in g if n.startswith("stickslip.adapters")]
-    assert len(adapters) >= 6
+    assert len(adapters) >= 6 and not g["stickslip.shipped"]
     for name in adapters:
         for dep in g[name]:
-            assert dep.startswith(("stickslip.adapters", "pyref")) or dep == "stickslip.columns", (name, dep)
+            assert dep.startswith(("stickslip.adapters", "pyref")) or dep in ("stickslip.columns", "stickslip.shipped"), \
+                (name, dep)
 
 
 def test_benchmarks_and_studies_are_leaves():
@@ -108,3 +111,60 @@ def test_benchmarks_and_studies_are_leaves():
                 assert name == "stickslip.cli", (name, dep)
             if dep.startswith("stickslip.studies") and not name.startswith(("stickslip.studies", "stickslip.bench")):
                 assert name in ("stickslip.cli", "stickslip.report"), (name, dep)
+
+
+# --- module size and the tools' imports -------------------------------------------------------
+MAX_LINES = 600  # a module longer than this holds more than one idea: split it along them
+CODE_FOLDERS = ("stickslip", "pyref", "yade_law", "tools", "deme_model")
+
+
+def long_modules(root=ROOT, folders=CODE_FOLDERS, limit=MAX_LINES):
+    """(path, lines) of every Python module under root/folders longer than `limit` lines."""
+    out = []
+    for folder in folders:
+        for path in sorted((root / folder).rglob("*.py")):
+            n = len(path.read_text().splitlines())
+            if n > limit:
+                out.append((path.relative_to(root).as_posix(), n))
+    return out
+
+
+def test_the_size_check_sees_a_long_module(tmp_path):
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "short.py").write_text("x = 1\n" * 600)
+    (tmp_path / "pkg" / "long.py").write_text("x = 1\n" * 601)
+    assert long_modules(tmp_path, ("pkg",)) == [("pkg/long.py", 601)]
+
+
+def test_no_module_is_over_600_lines():
+    assert long_modules() == []
+
+
+def tools_graph(folder=ROOT / "tools"):
+    """{tool module: the tool modules it imports}: the scripts in tools/ import each other by
+    their file names (the folder is on sys.path), at module level or inside functions."""
+    names = {p.stem: p for p in folder.glob("*.py")}
+    graph = {}
+    for name, path in names.items():
+        got = set()
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                got |= {a.name.split(".")[0] for a in node.names}
+            elif isinstance(node, ast.ImportFrom) and not node.level and node.module:
+                got.add(node.module.split(".")[0])
+        graph[name] = {m for m in got if m in names and m != name}
+    return graph
+
+
+def test_the_tools_graph_finds_a_circle(tmp_path):
+    (tmp_path / "a.py").write_text("def f():\n    import b\n")
+    (tmp_path / "b.py").write_text("from a import f\n")
+    (tmp_path / "c.py").write_text("import a\nimport numpy\n")
+    g = tools_graph(tmp_path)
+    assert g == {"a": {"b"}, "b": {"a"}, "c": {"a"}} and find_cycle(g) == ["a", "b", "a"]
+
+
+def test_no_import_circles_in_tools():
+    g = tools_graph()
+    assert "deme_plane_emulation" in g["deme_gpu_check"]  # (an import inside a function counts)
+    assert find_cycle(g) is None, " -> ".join(find_cycle(g))

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The benchmark's measuring tools (issue 32): the interval of a ratio measured in
 interleaved rounds, and the reading of callgrind's profiles. Cost: ~0.3 s in all."""
 import math
@@ -127,10 +128,10 @@ positions: instr line
 events: Ir
 summary: 22
 
-fl=(1) /src/a.cpp
+fl=(1) /usr/src/a.cpp
 fn=(1) f
 0x10 3 5
-cfi=(2) /src/b.h
+cfi=(2) /usr/src/b.h
 cfn=(2) g
 calls=2 0x40 7
 +4 4 8
@@ -153,9 +154,9 @@ def test_callgrind_instruction_lines_name_each_instructions_function_file_and_li
     p = tmp_path / "callgrind.out.1.1"
     p.write_text(PROFILE_LINES)
     got = callgrind.instruction_lines(p, lambda f: True)
-    assert got == {0x10: ("f", "/src/a.cpp", 3, 5), 0x18: ("f", "/src/a.cpp", 4, 1),
-                   0x1C: ("f", "/src/b.h", 10, 5), 0x20: ("f", "/src/b.h", 11, 2),
-                   0x24: ("f", "/src/a.cpp", 5, 2), 0x40: ("g", "/src/b.h", 7, 7)}
+    assert got == {0x10: ("f", "/usr/src/a.cpp", 3, 5), 0x18: ("f", "/usr/src/a.cpp", 4, 1),
+                   0x1C: ("f", "/usr/src/b.h", 10, 5), 0x20: ("f", "/usr/src/b.h", 11, 2),
+                   0x24: ("f", "/usr/src/a.cpp", 5, 2), 0x40: ("g", "/usr/src/b.h", 7, 7)}
     assert set(callgrind.instruction_lines(p, lambda f: f.endswith(".h"))) == {0x1C, 0x20, 0x40}
 
 
@@ -163,7 +164,7 @@ def test_liggghts_bench_round_ratios_are_each_rounds_geometric_mean_of_quiet_blo
     """liggghts_bench takes the round as the interval's unit: per round the geometric mean
     of its quiet blocks' ratios (a noisy block left out, a round without a quiet one left
     out). Two rounds of made-up chunks, the ratios worked out by hand."""
-    from stickslip.bench import liggghts as lb
+    from stickslip.bench import liggghts_rounds as lb
 
     def run(cpus, foreign):
         return {"chunks": [{"cpu": c * lb.CHUNK, "foreign": f} for c, f in zip(cpus, foreign)]}
@@ -177,9 +178,69 @@ def test_liggghts_bench_round_ratios_are_each_rounds_geometric_mean_of_quiet_blo
     round1 = {"history": run(a1, f1), "stick_slip": run(b1, quiet)}
     round2 = {"history": run([1.0] * n, noisy), "stick_slip": run([3.0] * n, quiet)}  # no quiet block
     round3 = {"history": run([2.0] * n, quiet), "stick_slip": run([3.0] * n, quiet)}
-    got = lb._round_ratios([round1, round2, round3], "stick_slip", "history", quiet_only=True)
+    got = lb.round_ratios([round1, round2, round3], "stick_slip", "history", quiet_only=True)
     # round 1 without block 5: 19 blocks of 8 and 20 of 2 -> exp((19 ln 8 + 20 ln 2)/39)
     assert got[0] == pytest.approx(math.exp((19 * math.log(8) + 20 * math.log(2)) / 39), rel=1e-12)
     assert got[1:] == [pytest.approx(1.5, rel=1e-12)] and len(got) == 2
-    every = lb._round_ratios([round1, round2, round3], "stick_slip", "history", quiet_only=False)
+    every = lb.round_ratios([round1, round2, round3], "stick_slip", "history", quiet_only=False)
     assert len(every) == 3 and every[1] == pytest.approx(3.0, rel=1e-12)
+
+
+def test_lammps_granular_bench_swaps_only_the_tangential_words_and_divides_each_law_by_its_stock(tmp_path):
+    """Issue 49 item 5's benchmark (stickslip/bench/lammps_granular.py), its plumbing on a
+    tiny bed (48 grains settled, 2 rounds of 20 + 50 steps; 13 LAMMPS 2025 runs: ~1 s of
+    CPU, a few seconds of wall time). Each law configuration's input is its stock's but for the tangential
+    words, on the pair and the floor wall alike, with the stock's Ks (or NULL), x and mu_s;
+    the order turns from round to round; the rows divide each law's time by its own stock's
+    (geometric mean over the rounds, over the quiet ones when there are 3), and its
+    instructions likewise."""
+    from conftest import skip_engine
+
+    skip_engine("lammps_granular")
+    from stickslip.bench import lammps_granular as lg
+
+    data = tmp_path / "bed.data"
+    assert set(lg.STOCK.values()) == {"linear_history", "mindlin"} and lg.NORMAL.startswith("hertz/material ")
+    for c, stock in lg.STOCK.items():
+        law, ref = lg.TANGENTIAL[c].split(), lg.TANGENTIAL[stock].split()
+        assert law[0] == ("stick_slip/exact" if c.endswith("exact") else "stick_slip")  # no /total: the paper's reset
+        assert law[1:4] == ref[1:4] and (law[1] == "NULL") == (stock == "mindlin")
+        assert float(lg.MU_K) < float(lg.MU_S) and law[3:] == [lg.MU_S, lg.MU_K]
+        text = lg.script(data, c)
+        where = [ln.split()[:2] + ln.split(" tangential ")[1].split()[:5] for ln in text.splitlines()
+                 if " tangential " in ln]
+        assert where == [["pair_coeff", "*"] + law, ["fix", "floor"] + law]
+        assert text.replace(lg.TANGENTIAL[c], "T") == lg.script(data, stock).replace(lg.TANGENTIAL[stock], "T")
+
+    res = lg.measure(2, counts=False, size=(4, 4, 3), steps=50, warm=20, cache=tmp_path)
+    bed = lg.bed((4, 4, 3), tmp_path)
+    assert [p.name for p in tmp_path.glob("*.data")] == [bed.name]  # made once, then read from the cache
+    assert res["bed"]["grains"] == 48 and res["bed"]["ke_per_grain"] < lg.KE_MAX
+    order = list(lg.TANGENTIAL)
+    assert [list(r) for r in res["rounds"]] == [order, order[1:] + order[:1]]
+    for r in res["rounds"]:
+        for x in r.values():
+            assert 0.0 < x["cpu"] < 5.0 and x["atoms"] == 48 and x["contacts0"] > 0
+
+    def row(c, what):
+        return next(r for r in lg.rows(res) if r["case"].startswith(f"{lg.label(c)} / ") and what in r["case"])
+    for c, stock in lg.STOCK.items():
+        logs = [math.log(r[c]["cpu"] / r[stock]["cpu"]) for r in res["rounds"]]
+        got = row(c, "time")
+        assert got["value"] == pytest.approx(math.exp(sum(logs) / 2), rel=1e-12)
+        assert got["ci_low"] < got["value"] < got["ci_high"]
+
+    # made-up rounds: each law costs 1.01 / 1.04 times its stock, whose two differ by 2x; a
+    # 5th round, noisy, gives 3x and is left out (4 quiet rounds)
+    factor = {"linear_history": 1.0, "ks_step": 1.01, "ks_exact": 1.04, "mindlin": 2.0, "null_step": 2.02,
+              "null_exact": 2.08}
+    made = [{c: dict(res["rounds"][0][c], cpu=f * s, foreign=0.0) for c, f in factor.items()} for s in (1, 2, 3, 5)]
+    made.append({c: dict(x, cpu=x["cpu"] * (3.0 if c in lg.STOCK else 1.0), foreign=1.0) for c, x in made[0].items()})
+    counts = {c: {"total": 1000 * f, "model": 100 * f, "tangential": 10 * f, "steps": 10} for c, f in factor.items()}
+    res = dict(res, rounds=made, counts=counts)
+    for c, stock in lg.STOCK.items():
+        expect = factor[c] / factor[stock]
+        assert row(c, "time")["value"] == pytest.approx(expect, rel=1e-12)
+        assert "the 4 quiet rounds of 5" in row(c, "time")["case"]
+        assert row(c, "busy rounds")["value"] == pytest.approx(3 * expect, rel=1e-12)
+        assert row(c, "instructions")["value"] == " / ".join([f"{expect:.4f}"] * 3)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`stickslip report`, `bench` and `thresholds` run for real through the command line
 (cli.main), reduced where the full run is long, checking what they write."""
 import csv

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Accurate enough, not only stable (issue 15 section 5): the restitution of an impact
 against the number of steps per contact, on pyref, and the warning below
 stability.CONTACT_STEPS.

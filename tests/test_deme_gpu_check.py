@@ -1,5 +1,7 @@
-"""tools/deme_gpu_check.py's parts that need no GPU: the contract rows' prescribed motion
-(expressions the engine compiles) against the states the rows state, and the summary."""
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""tools/deme_gpu_check.py's parts that need no GPU (and its modules deme_gpu_contract.py,
+deme_gpu_bench.py, deme_fn_ring.py): the contract rows' prescribed motion (expressions the
+engine compiles) against the states the rows state, the bounds, the bench and the summary."""
 import json
 import subprocess
 import sys
@@ -13,7 +15,10 @@ import deme_shim
 import law_contract as lc
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tools"))
+import deme_fn_ring as fn_ring  # noqa: E402
+import deme_gpu_bench as bench  # noqa: E402
 import deme_gpu_check as check  # noqa: E402
+import deme_gpu_contract as contract  # noqa: E402
 
 
 def test_contract_rows_prescribed_as_they_are_stated():
@@ -23,12 +28,12 @@ def test_contract_rows_prescribed_as_they_are_stated():
     the step before; step 1 the initial state): to 1e-12 m, m/s, rad/s (doubles; the engine's
     grid of 64 m / 2^37 = 4.7e-10 m rounds them again)."""
     cases = [deme_shim.float_case(c) for c in lc.CASES]
-    bases = check.row_layout(cases)
+    bases = contract.row_layout(cases)
     funcs, wanted = [], []
     for c, (case, base) in enumerate(zip(cases, bases)):
         n_bodies = 1 if case.geometry == "wall" else 2
         for body in range(n_bodies):
-            exprs = [e for group in check.row_prescription(case, body, base) for e in group]
+            exprs = [e for group in contract.row_prescription(case, body, base) for e in group]
             funcs.append(f"static void f{len(funcs)}(float t, double *o) {{ " +
                          " ".join(f"o[{i}] = {e};" for i, e in enumerate(exprs)) + " }")
             states, start, k = [], runners.rest_positions(case, case.segments[0].delta), 0
@@ -71,7 +76,7 @@ def test_drag_bounds_pass_pyref_against_itself_and_catch_an_early_slip():
     s = analysis.summarise(sc, df)
     for key, bound in check.drag_bounds(sc, ring).items():
         assert s[key] is not None and bound > 0
-    f = check.fn_spread(sc, df)  # pyref starts at its static overlap: Fn = W to 1e-3
+    f = fn_ring.fn_spread(sc, df)  # pyref starts at its static overlap: Fn = W to 1e-3
     assert abs(f["first"] - 1) < 1e-3 and f["min"] <= f["first"] <= f["max"] < 1 + 1e-3
     early = df.copy()
     c = "grain-floor"
@@ -181,8 +186,8 @@ def test_bench_reads_the_engines_own_statistics(tmp_path, monkeypatch):
         work=str(work), parts=["bench", "warm_stock"], bench_grid=2, rounds=3, bench_steps=10, settle_steps=5,
         cd_freq=20, control=True, t0=check.time.time(), deadline=60.0)
     _BenchSolver.log = []
-    monkeypatch.setattr(check, "wait_json", lambda path, timeout: _BenchSolver.log.append((None, "wait", path.name)))
-    out = check.run_bench(args, lambda msg: None)
+    monkeypatch.setattr(bench, "wait_json", lambda path, timeout: _BenchSolver.log.append((None, "wait", path.name)))
+    out = bench.run_bench(args, lambda msg: None)
     # each pair waits once for warm_stock, before its first stock solver is made
     calls = [(name, a) for i, name, a in _BenchSolver.log if name in ("wait", "UseFrictionalHertzianModel")]
     assert calls == [("wait", "warm_stock.json"), ("UseFrictionalHertzianModel", ())] * 3 \
@@ -221,7 +226,7 @@ def test_the_pages_gpu_figure_is_made_from_the_stored_series(tmp_path):
     png = fig.main(ROOT / "deme_model" / "measured", tmp_path / "f.png")
     assert png.stat().st_size > 20_000
     st = scene.load("tilt")
-    t, ratio = check.sticking_fn_over_weight(st, pd.read_csv(ROOT / "deme_model" / "measured" / "tilt_deme.csv.gz"))
+    t, ratio = fn_ring.sticking_fn_over_weight(st, pd.read_csv(ROOT / "deme_model" / "measured" / "tilt_deme.csv.gz"))
     assert (round(ratio.min(), 3), round(ratio.max(), 3)) == (0.646, 1.350)
     assert round(t[-1] + (t[1] - t[0]), 4) == 0.9272  # the first slip's row: the page's 0.9272 s
     quiet = np.abs(ratio[t < 0.444] - 1)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The engine's float geometry on a plane, emulated on the CPU (tools/deme_plane_emulation.py):
 the force model through its shim, on the overlap DEM-Engine would hand it, against pyref,
 within the GPU check's bounds (tools/deme_gpu_check.py). With the engine's own overlap (a
@@ -10,6 +11,7 @@ from pathlib import Path
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tools"))
+import deme_fn_ring as fn_ring  # noqa: E402
 import deme_gpu_check as check  # noqa: E402
 import deme_plane_emulation as emulation  # noqa: E402
 
@@ -21,7 +23,7 @@ def _outside(runs, bounds, label):
 
 def _ring(figures):
     """float_ring from a run's figures (report's fn_over_w_*), without a second run."""
-    return check.ring_of({k: figures[f"fn_over_w_{k}"] for k in ("min", "max")})
+    return fn_ring.ring_of({k: figures[f"fn_over_w_{k}"] for k in ("min", "max")})
 
 
 def test_drag_keeps_its_bounds_on_the_models_distance_only():

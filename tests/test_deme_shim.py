@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """DEM-Engine's force model (deme_model/stick_slip.cu) pinned without a GPU: the same file,
 compiled on the CPU through deme_model/shim/ (tests/deme_shim.py), through every row of the
 law's contract in float, and the parts the contract's rows do not reach (the engine's

@@ -1,15 +1,20 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The documentation holds: every relative link and anchor of every *.md resolves, user pages
-carry no dates, work-session talk, machine paths or links outside the repository (dated
-measurements live in the history sections of docs/performance.md and docs/testing.md), and
+carry no dates, work-session talk or links outside the repository (dated measurements live in
+the history sections of docs/performance.md and docs/testing.md), every page speaks
+impersonally (no first person, issue numbers or notebook phrases), no tracked file names a
+machine's own folders, the suite's test counts the pages state are the suite's, and
 every example input the docs call runnable runs on its engine (short: a few thousand steps).
 
 The YADE example (yade_law/example_drag.py) is run by tests/test_yade_law.py; `stickslip run`
 by tests/test_cli_studies.py.
 """
+import json
 import os
 import re
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -94,24 +99,231 @@ def test_every_relative_link_and_anchor_resolves():
 
 DATE = re.compile(r"\b20\d\d-[01]\d-[0-3]\d\b")
 HYGIENE = [(DATE, "a date"), (re.compile(r"\b[Ss]essions?\b"), "work-session talk"),
-           (re.compile(r"(?<![\w.])/(work|home|root)/"), "an absolute machine path"),
            (re.compile(r"\.\./shared/|shared notes"), "notes outside the repository"),
            (re.compile(r"\]\(\s*<?https?:"), "a link outside the repository")]
 
 
-def test_user_pages_carry_no_dates_sessions_machine_paths_or_outside_links():
-    """Dates and measurement history only under '## History' of docs/performance.md and
-    docs/testing.md; the rest nowhere."""
+def shown(page):
+    """A page's path as the findings name it: relative to the repository's root."""
+    return page.relative_to(ROOT).as_posix() if page.is_relative_to(ROOT) else str(page)
+
+
+def page_lines(page):
+    """(line number, text, inside its page's History section) of a page's lines."""
+    history = False
+    for n, line in enumerate(page.read_text().splitlines(), 1):
+        history = history or (shown(page) in HISTORY_PAGES and line.startswith("## History"))
+        yield n, line, history
+
+
+def test_user_pages_carry_no_dates_sessions_or_outside_links():
+    """Dates only under '## History' of docs/performance.md and docs/testing.md; work-session
+    talk, notes outside the repository and outside links nowhere."""
     found = []
     for page in markdown_files():
-        rel = page.relative_to(ROOT).as_posix()
-        history = False
-        for n, line in enumerate(page.read_text().splitlines(), 1):
-            history = history or (rel in HISTORY_PAGES and line.startswith("## History"))
+        for n, line, history in page_lines(page):
             for pattern, what in HYGIENE:
-                if pattern.search(line) and not (history and what in ("a date", "work-session talk")):
-                    found.append(f"{rel}:{n}: {what}: {line.strip()[:100]}")
+                if pattern.search(line) and not (history and what == "a date"):
+                    found.append(f"{page.relative_to(ROOT)}:{n}: {what}: {line.strip()[:100]}")
     assert not found, "\n".join(found)
+
+
+# --- how the pages speak ----------------------------------------------------------------------
+# Every page, its History sections included, says what is true impersonally: no first person
+# (a microsecond written "us" after a number is a unit; a type pair's index "I" comes with a
+# "J": I..J, I ≠ J), no issue numbers of this project (another project's, "owner/repo#N", may
+# be cited), no phrases of a lab notebook. History may hold dates, commit ids, the machine's
+# load and the suite's or a benchmark's figures as they were measured then; nothing else is
+# special there.
+FIRST_PERSON = re.compile(r"\b(?:[Ww]e|[Oo]urs?|[Oo]urselves|I(?!\s*\S{0,2}\s*J\b)|[Mm]e|[Mm]y)\b"
+                          r"|(?<!\d )(?<!\d)\b[Uu]s\b")
+ISSUE = re.compile(r"\b[Ii]ssues? #?\d+|(?<![\w/#])#\d+\b")
+NOTEBOOK = re.compile(r"\b(?:given up|gave up|not retrieved|if asked|what was asked|asked of it|(?:what )?we found|"
+                      r"scratch scripts?|not committed|the issue|project's notes|gpu lent|device tool|todo|fixme|"
+                      r"for now)\b", re.IGNORECASE)
+
+
+def prose_without_links(page):
+    """prose_lines with each link's target dropped (its text kept)."""
+    for n, text in prose_lines(page):
+        yield n, re.sub(r"\]\([^)]*\)", "]", text)
+
+
+def voice_findings(lines):
+    """What breaks the pages' voice in (line number, prose) pairs: one line per finding."""
+    found = []
+    for n, text in lines:
+        for what, pattern in (("first person", FIRST_PERSON), ("an issue number", ISSUE),
+                              ("a notebook phrase", NOTEBOOK)):
+            hit = pattern.search(text)
+            if hit:
+                found.append(f"{n}: {what} ({hit.group(0)!r}): {text.strip()[:90]}")
+    return found
+
+
+def test_voice_findings_catch_each_kind():
+    lines = list(enumerate(["What we found", "as our runs show", "I ran it", "issue 24 asked", "(#12)",
+                            "Given up: the fall", "Not retrieved, so", "Size, if asked", "5 us a step",
+                            "lammps/lammps#3022", "for I ≠ J and I..J", "The drag's saw-tooth"], 1))
+    got = voice_findings([(n, re.sub(r"`[^`]*`", "``", t)) for n, t in lines])
+    assert [int(f.split(":")[0]) for f in got] == [1, 1, 2, 3, 4, 5, 6, 7, 8], got
+
+
+def test_pages_speak_impersonally():
+    found = [f"{page.relative_to(ROOT)}:{f}" for page in markdown_files()
+             for f in voice_findings(prose_without_links(page))]
+    assert not found, "\n".join(found)
+
+
+# --- absolute paths ---------------------------------------------------------------------------
+# An absolute path names one machine's folders unless the operating system or an installed
+# package puts it there on every machine: the FHS's /usr, /etc and /bin (an installed
+# package's files, e.g. /usr/share/lammps/examples, /etc/apt/sources.list.d) and the
+# kernel's /proc, /sys and /dev. Anything else (/tmp, /work, /home, /root, /opt, /mnt, ...) is
+# refused in every text file git tracks or would track, code included: a temporary folder
+# is $TMPDIR (a shell's `${TMPDIR:-/tmp}`) or Python's tempfile, the repository's own files
+# are relative to it, and a placeholder is written /path/to/...
+ABSOLUTE = re.compile(r"(?<![\w.~$}\]:/*-])(?<!\w\")/([A-Za-z_][\w.+-]*)/[\w.+-][\w.+/-]*")
+SYSTEM = {"usr", "etc", "bin", "proc", "sys", "dev", "path"}
+
+
+def text_files():
+    """(path relative to the root, text) of every file git tracks or would track that is text:
+    files with a NUL byte or not UTF-8 are left out."""
+    out = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=ROOT, capture_output=True,
+                         text=True, check=True).stdout.splitlines()
+    for rel in out:
+        path = ROOT / rel
+        if not path.is_file():
+            continue  # (deleted in the working tree)
+        data = path.read_bytes()
+        if b"\0" in data:
+            continue
+        try:
+            yield rel, data.decode()
+        except UnicodeDecodeError:
+            continue
+
+
+def machine_paths(text):
+    """(line number, path) of each absolute path of `text` outside SYSTEM."""
+    return [(text.count("\n", 0, m.start()) + 1, m.group(0)) for m in ABSOLUTE.finditer(text)
+            if m.group(1) not in SYSTEM]
+
+
+def test_machine_paths_are_told_from_system_ones():
+    assert machine_paths('--out /tmp/t\n"/work/main/x", (/root/.cache/y), cd /home/u/z') == [
+        (1, "/tmp/t"), (2, "/work/main/x"), (2, "/root/.cache/y"), (2, "/home/u/z")]
+    assert machine_paths("/usr/share/lammps/examples /etc/apt/x /proc/PID/stat >/dev/null #!/usr/bin/env "
+                         "/path/to/build https://github.com/a/b lammps/lammps#3022 m/s/x ${TMPDIR:-/tmp}/w "
+                         "'*/src/*.h' \"$top\"/download/x") == []
+
+
+def test_no_file_names_a_machines_folders():
+    this = Path(__file__).relative_to(ROOT).as_posix()  # (its own examples of what is refused)
+    found = [f"{rel}:{n}: {path}" for rel, text in text_files() if rel != this for n, path in machine_paths(text)]
+    assert not found, "\n".join(found)
+
+
+# --- counts of the suite's tests --------------------------------------------------------------
+# A page may state the suite's size once ("N tests: D in the default suite, S opt-in") and a
+# file's count as "test_file (N)"; outside History every other "N tests" is a count nothing
+# checks, and is refused. History keeps its counts as they were measured on their dates.
+SUITE = re.compile(r"\b(\d+) tests: (\d+) in the default suite, (\d+) opt-in\b")
+FILE_COUNT = re.compile(r"\b(test_\w+) \((\d+)\)")
+ANY_COUNT = re.compile(r"\b\d+ (?:(?:default|opt-in|new) )?tests\b(?! (?:the|that|whether|if|each|every|a|an)\b)")
+CENSUS = """
+import json, sys, pytest
+class Census:
+    def pytest_collection_finish(self, session):
+        self.items = [[i.nodeid.split("::")[0], "slow" in i.keywords] for i in session.items]
+census = Census()
+code = pytest.main(["--collect-only", "-q", "-p", "no:cacheprovider", "-p", "no:xdist", "tests"], plugins=[census])
+json.dump({"code": int(code), "items": getattr(census, "items", None)}, open(sys.argv[1], "w"))
+"""
+
+
+def suite_census(tmp_path):
+    """{test file stem: [tests, opt-in tests]} of the whole suite as pytest collects it, in a
+    process of its own (~3 s): this session may have collected only a part of it."""
+    out = tmp_path / "census.json"
+    subprocess.run([sys.executable, "-c", CENSUS, str(out)], cwd=ROOT, capture_output=True, timeout=300)
+    got = json.loads(out.read_text())
+    assert got["code"] == 0 and got["items"], f"the suite's collection failed (pytest exit {got['code']})"
+    files = {}
+    for path, slow in got["items"]:
+        n = files.setdefault(Path(path).stem, [0, 0])
+        n[0], n[1] = n[0] + 1, n[1] + slow
+    return files
+
+
+def count_findings(pages, files):
+    """Each stated count (outside History) that disagrees with `files` (suite_census), or that
+    nothing checks: one line each."""
+    total, optin = sum(n for n, _ in files.values()), sum(s for _, s in files.values())
+    found = []
+    for page in pages:
+        for n, line, history in page_lines(page):
+            if history:
+                continue
+            where = f"{shown(page)}:{n}"
+            checked = []
+            for m in SUITE.finditer(line):
+                checked.append(m.span())
+                if tuple(map(int, m.groups())) != (total, total - optin, optin):
+                    found.append(f"{where}: {m.group(0)!r}, the suite: {total} tests: {total - optin} in the "
+                                 f"default suite, {optin} opt-in")
+            for m in FILE_COUNT.finditer(line):
+                if files.get(m.group(1), [None])[0] != int(m.group(2)):
+                    found.append(f"{where}: {m.group(0)!r}, the suite: {files.get(m.group(1), ['no such file'])[0]}")
+            for m in ANY_COUNT.finditer(line):
+                if not any(a <= m.start() < b for a, b in checked):
+                    found.append(f"{where}: {m.group(0)!r}, a count of tests nothing checks")
+    return found
+
+
+def test_count_findings_catch_each_kind(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("10 tests: 8 in the default suite, 2 opt-in.\n| a | test_a (7), test_b (3) |\n"
+                    "771 tests: 755 in the default suite, 16 opt-in.\n| b | test_b (4), test_c (1) |\n"
+                    "The profile: 708 tests in the default suite.\n")
+    files = {"test_a": [7, 2], "test_b": [3, 0]}
+    got = [f.split(": ", 1)[1] for f in count_findings([page], files)]
+    assert got == ["'771 tests: 755 in the default suite, 16 opt-in', the suite: 10 tests: 8 in the default "
+                   "suite, 2 opt-in", "'test_b (4)', the suite: 3", "'test_c (1)', the suite: no such file",
+                   "'708 tests', a count of tests nothing checks"], got
+
+
+def test_stated_test_counts_are_the_suites(tmp_path):
+    found = count_findings(markdown_files(), suite_census(tmp_path))
+    assert not found, "\n".join(found)
+
+
+# --- what the pages say the code accepts ------------------------------------------------------
+def test_readmes_engine_list_is_the_clis():
+    """The README's `--engine a|b|...` names every engine `stickslip run` takes."""
+    from stickslip.adapters import ENGINES, OPTIONAL_ENGINES
+
+    listed = re.findall(r"--engine ((?:[a-z_]+\|)+[a-z_]+)", (ROOT / "README.md").read_text())
+    assert listed and all(sorted(x.split("|")) == sorted(ENGINES + OPTIONAL_ENGINES) for x in listed), listed
+
+
+def test_mu_s_range_is_the_codes_on_every_page():
+    """μs: > 0 where pyref's checker (every Python engine and LIGGGHTS) refuses 0, and LAMMPS'
+    stock range 0 <= xmu <= hi where its pair style checks that; the README's table says both,
+    the pair style's page says LAMMPS'."""
+    from pyref.laws import check_parameters
+
+    with pytest.raises(ValueError, match="mu_s = 0: must be > 0"):
+        check_parameters(mu_s=0.0)
+    cpp = (ROOT / "lammps_plugin/pair_gran_hooke_stickslip.cpp").read_text()
+    hi = re.search(r'"xmu \(mu_s\)", xmu, xmu >= 0\.0 && xmu <= ([\d.]+),', cpp).group(1)
+    hi = f"{float(hi):g}"
+    row = next(ln for ln in (ROOT / "README.md").read_text().splitlines() if ln.startswith("| μs |"))
+    allowed = row.split("|")[4]
+    assert "> 0" in allowed and "LAMMPS" in allowed and f"0–{hi}" in allowed, row
+    page = (ROOT / "lammps_plugin/doc/pair_gran_hooke_stickslip.md").read_text()
+    assert f"0 ≤ xmu ≤ {hi}" in page and f"`mu_s V` (0 ≤ V ≤ {hi})" in page
 
 
 # --- the example inputs ---------------------------------------------------------------------
@@ -144,11 +356,14 @@ DRAG_MEAN, DRAG_TOL, DRAG_SLIPS = 0.4505, 0.006, 11
 
 LIGGGHTS_EXAMPLES = {"in.drag2d": (), "in.pour3d": ("-var", "steps", SHORT)}
 LAMMPS_EXAMPLES = {"in.drag2d": (), "in.pour3d": ("-var", "steps", SHORT), "in.region_wall": ("-var", "steps", SHORT)}
+# (the granular model's examples, lammps_plugin/examples/in.granular_*, run on LAMMPS 2025)
+LAMMPS_2025_EXAMPLES = {"in.granular_drag2d": (), "in.granular_pour3d": ("-var", "steps", SHORT)}
 
 
 def test_every_example_input_is_run_here():
     """A new example in an examples/ folder must be added to the lists above (and so be run)."""
-    for folder, listed in (("liggghts_plugin/examples", LIGGGHTS_EXAMPLES), ("lammps_plugin/examples", LAMMPS_EXAMPLES)):
+    for folder, listed in (("liggghts_plugin/examples", LIGGGHTS_EXAMPLES),
+                           ("lammps_plugin/examples", {**LAMMPS_EXAMPLES, **LAMMPS_2025_EXAMPLES})):
         assert sorted(p.name for p in (ROOT / folder).glob("in.*")) == sorted(listed), folder
 
 
@@ -174,3 +389,85 @@ def test_lammps_example_runs(tmp_path, name):
         assert abs(mean - DRAG_MEAN) <= DRAG_TOL and slips == DRAG_SLIPS, (mean, slips)
     else:
         assert f"after {SHORT} steps" in out
+
+
+@pytest.mark.parametrize("name", sorted(LAMMPS_2025_EXAMPLES))
+def test_lammps_2025_example_runs(tmp_path, name):
+    """The granular model's examples on the LAMMPS built with the sub-model: the drag's
+    saw-tooth as the legacy styles' example gives it, the pour's short run to its end."""
+    from stickslip.adapters import lammps_granular
+
+    skip_engine("lammps_granular")
+    out = run_example(lammps_granular.LAUNCHER, ROOT / "lammps_plugin/examples" / name, tmp_path,
+                      "-echo", "none", "-nocite", *LAMMPS_2025_EXAMPLES[name])
+    if name == "in.granular_drag2d":
+        mean, slips = mean_ratio(out)
+        assert abs(mean - DRAG_MEAN) <= DRAG_TOL and slips == DRAG_SLIPS, (mean, slips)
+    else:
+        assert f"after {SHORT} steps" in out
+
+
+# --- DEM-Engine's example ---------------------------------------------------------------------
+# deme_model/example_drag.py needs an NVIDIA GPU. Without one, what can run here does: its
+# set-up, against a stand-in `deme` that records every call, is call for call the set-up of
+# `stickslip run drag --engine deme` (the run the GPU check measured within its bounds,
+# deme_model/README.md), and its reading of the engine's record, fed pyref's drag, prints the
+# figures the LIGGGHTS and LAMMPS drags print. With a GPU it runs whole.
+DEME_EXAMPLE = ROOT / "deme_model" / "example_drag.py"
+
+
+def deme_example():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("deme_example_drag", DEME_EXAMPLE)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def plain(x):
+    """A call's arguments with the stand-in's objects (each call's own) as their type's name."""
+    if isinstance(x, (list, tuple)):
+        return [plain(v) for v in x]
+    return x if isinstance(x, (str, int, float, bool, dict, type(None))) else type(x).__name__
+
+
+def test_deme_example_sets_up_the_drag_as_the_adapter_does():
+    from deme_standin import FakeDeme
+
+    from stickslip import scene as scene_mod
+    from stickslip.adapters import deme as adapter
+
+    example, run = FakeDeme(), FakeDeme()
+    deme_example().build(example)
+    adapter.build(scene_mod.load("drag"), run)
+    assert len(example.log) > 20 and plain(example.log) == plain(run.log)
+
+
+def test_deme_example_reads_the_drag_from_the_record(capsys):
+    from conftest import paper_case
+    from deme_standin import FakeDeme
+
+    sc, df = paper_case("drag")
+    c = "grain-floor"
+    slips = df[f"{c}_slip"].cumsum()
+    values = {"ss_rec_fn": df[f"{c}_fn"], "ss_rec_fx": df[f"{c}_ftx"], "ss_rec_fy": df[f"{c}_fty"], "ss_rec_slips": slips}
+
+    def record(family, name, step):  # the grain's record after `step` steps: pyref's row `step`
+        return float(values[name].iat[step]) if name in values else 0.0
+    deme_example().main(FakeDeme(record=record))
+    mean, count = mean_ratio(capsys.readouterr().out)
+    assert abs(mean - DRAG_MEAN) <= DRAG_TOL and count == DRAG_SLIPS, (mean, count)
+
+
+def test_deme_example_runs_on_a_gpu(tmp_path):
+    from stickslip.adapters import deme as adapter
+
+    why = adapter.available()
+    if why:
+        pytest.skip(f"DEM-Engine cannot run here ({why}): the example's set-up and reading are tested above")
+    proc = subprocess.run([sys.executable, str(DEME_EXAMPLE)], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=1800)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    mean, count = mean_ratio(proc.stdout)
+    assert abs(mean - DRAG_MEAN) <= DRAG_TOL and count == DRAG_SLIPS, (mean, count)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The turning drum (issue 24): its scene format, its physics on pyref and LIGGGHTS, the
 kind that measures its avalanches, and the study command's refusals."""
 import copy

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Exact slip timing (docs/law.md E0-E7) on pyref: the kernel against fine sub-stepping,
 bounded cost, and the modes on the paper's cases."""
 import math

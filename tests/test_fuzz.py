@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Fuzz: malformed scenes and bad command lines (issue 15 section 6).
 
 A seeded generator mutates the shipped scenes (and a small 3D scene with a lattice, a

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The LAMMPS plugin as a drop-in (issue 30, item 2): with the stock arguments and no
 extra keyword, `pair_style gran/hooke/stickslip` + `fix wall/gran/stickslip` must give
 stock `gran/hooke/history` + `wall/gran hooke/history` output bit for bit.

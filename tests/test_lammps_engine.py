@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The LAMMPS plugin against pyref on the paper's cases, through the adapter (issue 30, item 3).
 
 LAMMPS and pyref integrate the same way (velocity Verlet: forces from x(t) and v(t - dt/2),

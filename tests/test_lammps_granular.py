@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The tangential sub-model `stick_slip` in LAMMPS 2025's granular model (lammps_plugin/granular/,
 the adapter stickslip/adapters/lammps_granular.py) against pyref on the paper's cases.
 
@@ -108,3 +109,44 @@ def test_a_tangential_dashpot_without_a_normal_one_is_refused(tmp_path):
 def test_the_dashpot_ratio_gives_nu_s_to_the_last_bit(nu_s, nu_n):
     x = lammps_granular.dashpot_ratio(nu_s, nu_n)
     assert x * nu_n == nu_s
+
+
+def test_unlike_types_mix_by_geometric_means(tmp_path):
+    """Types 1 and 2 given their own coefficients only (pair_coeff 1 1, 2 2): a 1-2 contact
+    takes the geometric means, mu_s = sqrt(0.25 * 1.0) = 0.5 and mu_k = sqrt(0.2 * 0.8).
+    A grain pair of types 1 and 2 slides at 1/64 of a unit a step with Fn = 1 and Ks = 1
+    (law_contract's units): the spring reaches mu_s = 0.5 at step 32 exactly, the first
+    slip, and the force drops to 2 mu_k - mu_s (1 ulp: the slip's rescale). Read from
+    compute pair/local's record (p13-p17)."""
+    import math
+
+    import numpy as np
+
+    import law_contract as lc
+    import lammps_runs
+    from contract_runners import LAMMPS_HEAD, _f, granular_model, lammps_pair_local, lammps_pair_row
+
+    d = 2 * lc.R - lc.DELTA
+    own = {1: (0.25, 0.2), 2: (1.0, 0.8)}
+    lines = [LAMMPS_HEAD.format(ntypes=2, dt=_f(lc.DT)), "pair_style granular"]
+    for t, (ms, mk) in own.items():
+        case = lc.Case("", "", "pair", (), ms, mk)
+        lines.append(f"pair_coeff {t} {t} {granular_model(case)}")
+    for b, (t, x) in enumerate(((1, -d / 2), (2, d / 2))):
+        v = 0.25 if b == 0 else 0.0  # 1/64 a step along y
+        lines += [f"create_atoms {t} single {_f(x)} 0.0 0.0 units box",
+                  f"set atom {b + 1} diameter {_f(2 * lc.R)} density 1000 vx 0.0 vy {_f(v)} vz 0.0"]
+    # places and velocities held (nothing integrated, as the contract's rows): grain 1 moves
+    # at 0.25 along y without moving, grain 2 is still
+    lines += ["variable zero equal 0.0", "variable vy equal 0.25", "group g1 id 1", "group g2 id 2",
+              "fix mv1 g1 move variable v_zero v_zero v_zero v_zero v_vy v_zero",
+              "fix mv2 g2 move variable v_zero v_zero v_zero v_zero v_zero v_zero"]
+    lines += lammps_pair_local((13, 14, 15, 16, 17)) + ["run 40"]
+    lammps_runs.run_lammps(tmp_path, "mix", "\n".join(lines) + "\n", exe=lammps_granular.LAUNCHER)
+    pairs = lammps_runs.read_dump(tmp_path / "dump.pairs")
+    rows = np.array([lammps_pair_row(pairs[s], 1, [1, 2, 3]) for s in range(1, 41)])
+    slips = rows[:, 4]
+    mu_s, mu_k = math.sqrt(0.25 * 1.0), math.sqrt(0.2 * 0.8)
+    assert slips[30] == 0 and slips[31] == 1  # the first slip at step 32: 32/64 = mu_s
+    fmin = (2 * mu_k - mu_s) * 1.0
+    assert abs(np.linalg.norm(rows[31, 1:4]) - fmin) <= np.spacing(fmin), (rows[31], fmin)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """How long 1 and 2 ranks agree on a flowing pile (issue 30, item 4), stock against ours.
 
 LAMMPS is not rank-independent on a pile: a grain's force is a sum over its contacts in the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The LAMMPS plugin (lammps_plugin/): the stick-slip law in `pair_style
 gran/hooke/stickslip` and `fix wall/gran/stickslip`, run through raw input scripts on
 Debian's LAMMPS (the stock-parity checks are in test_lammps_dropin.py).

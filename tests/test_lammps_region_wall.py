@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """fix wall/gran/region/stickslip (lammps_plugin/fix_wall_gran_region_stickslip.*): stock
 wall/gran/region's arguments with the stick-slip law, the wall the engine adapter needs
 for turning and oblique planes (its agreement with pyref on the tilt: test_lammps_engine.py).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Restarts of the LAMMPS plugin (issue 30, item 4): `write_restart` and `read_restart`
 continue every contact's history (the spring D, and with `record yes` Fn, F_s, the slip
 count and the dissipated work), on the same rank count and across rank counts; and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The law's contract on every engine (tests/law_contract.py): one-contact cases with
 exact numbers, each engine's record compared to hand-worked values to the ulp."""
 import math

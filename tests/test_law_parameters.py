@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """pyref's parameter rules (pyref.laws.check_parameters, docs/law.md): the one checker of the
 Python engines (scenes, the YADE law). Each refusal is one message that names the parameter
 and what is allowed; each acceptance returns the values as floats. Cost: < 0.1 s."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`tangential stick_slip` as a drop-in for LIGGGHTS' stock `tangential history` (issue 16):
 with mu_k = mu_s and no tangential damping it is the same elastic-plastic spring, under
 LIGGGHTS' defaults; where it keeps a deliberate difference (the turn of D keeps its length,

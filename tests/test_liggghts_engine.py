@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The LIGGGHTS plugin against pyref on the paper's cases, through the adapter (issue 3).
 
 LIGGGHTS and pyref integrate the same way (velocity Verlet, forces from x(t) and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The LIGGGHTS plugin (`tangential stick_slip`) run directly through raw input scripts.
 
 Each test writes its input script (templates in tests/liggghts/, placeholders @NAME@)

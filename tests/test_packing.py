@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """A poured packing settling: no NaN, kinetic energy decays, friction never creates
 energy in any contact, and the energy books balance (pyref)."""
 import tomllib

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """What accuracy costs (issue 5): dt ladders, the every-step-slips speed, the warning."""
 import copy
 import csv

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """3D form of the law: history kept in the tangent plane, objectivity."""
 import tomllib
 

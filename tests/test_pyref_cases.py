@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The paper's three cases on pyref (issue 2's acceptance figures)."""
 import math
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The friction law never adds energy, and the energy books balance."""
 import numpy as np
 import pytest

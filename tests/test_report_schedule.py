@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """How the report spends its two cores (issue 25): every task's cost in seconds, so the
 longest runs start first whatever their kind, and a run asked for twice runs once."""
 import pytest

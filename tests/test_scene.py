@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Malformed scenes are refused with a message naming the key and the allowed range."""
 import subprocess
 import sys

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Hard cases that must stay numerically stable (pyref), in both slip timings.
 
 Invariants checked at every step: all values finite, |Fs| <= mu_s*Fn (the law never

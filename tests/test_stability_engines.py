@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Hard cases on the engines (issue 5): the scenes of tests/test_stability.py that a
 scene file can express, run through the LIGGGHTS and YADE adapters.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """pyref's kernel for the paper's Table 1 laws other than stick-slip (Coulomb, visco-plastic,
 visco-elastic) and the energy it reports, one step at a time with values worked out by
 hand (exact in binary). pyref and YADE run this kernel; LIGGGHTS and LAMMPS have only

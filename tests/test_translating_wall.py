@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """A translating wall on every engine (issue 31: no engine ran one). The drag seen from
 the grain: the grain held still and the floor drawn under it at -V. Relative motion is all
 the law sees (docs/law.md step 1: V_s = v_i - v_wall at the contact point), and the floor

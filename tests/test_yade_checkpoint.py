@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """YADE checkpoints (issue 15 §1): the law's state survives O.saveTmp/loadTmp, O.save/load
 in the same process and in a new one, and going back to a checkpoint; a scene whose
 state was not saved with it is refused loudly, never restarted silently.

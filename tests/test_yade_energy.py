@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Energy books of the YADE law (issue 16 §3): a 3D pour of 125 spheres in a box.
 
 With O.trackEnergy the law books in O.energy what it dissipates (slips, tangential

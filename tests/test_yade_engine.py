@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The YADE law against pyref on the paper's cases (issue 4), and its parameter errors."""
 import subprocess
 import sys

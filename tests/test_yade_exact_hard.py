@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The hard cases of tests/test_stability_engines.py on YADE in the exact slip timing
 (issue 13: "the hard-case suite passes in exact mode"), and a drag with hundreds of
 slips in one step. Same invariants: every recorded value finite, |Fs| <= mu_s*Fn

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Bad input to the YADE law is one clear line (issue 15 §3): every argument of
 stickslip_material / stickslip_engines is checked (ValueError naming it and what is
 allowed), numpy scalars are numbers, and a run whose values go non-finite stops with a

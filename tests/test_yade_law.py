@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The Python stick-slip law inside YADE (yade_law/stickslip_yade/), driven as
 `yade -n -x` subprocesses. Expected values are derived from the law (docs/law.md)
 and the parameters; tolerances come from the time step (a slip is detected on the

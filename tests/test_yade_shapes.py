@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Facets, periodic cells and clumps with the YADE law (issue 19).
 
 1. With mu_k = mu_s and nu_s = 0 the law is the classic elastic-plastic (Cundall-Strack)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Two engines that do the same arithmetic in another order, row by row: the round-off bound.
 
 At each step an engine may round a coordinate differently, by u L (L: the largest coordinate

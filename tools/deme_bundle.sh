@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # DEM-Engine for a GPU machine without network: the `deme` 3.0.19 wheel and the CUDA 12.8
 # wheels it compiles with (runtime, NVRTC, nvcc's and cuRAND's headers, CCCL), unpacked into
 # one site/ folder and packed as OUT_DIR/deme-bundle.tar.xz (~39 MB) for tools/gpu_check.sh.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """DEM-Engine's page's picture: the paper's drag and tilt as the GPU ran them (the time series
 the GPU check leaves, tools/gpu_check.sh: drag_deme.csv.gz, tilt_deme.csv.gz).
 
@@ -17,7 +18,7 @@ import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tools")]
-from deme_gpu_check import sticking_fn_over_weight  # noqa: E402
+from deme_fn_ring import sticking_fn_over_weight  # noqa: E402
 from pyref import Simulation  # noqa: E402
 from stickslip import columns, plotstyle, scene  # noqa: E402
 from stickslip.kinds import drag  # noqa: E402

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The paper's one-grain cases (drag, tilt) as DEM-Engine computes a grain on a plane, on
 the CPU: what the engine's float geometry does to them, with and without the force model's
 own distance in double (deme_model/stick_slip.cu, step 0).
@@ -140,7 +141,7 @@ def emulate(scene, model_distance):
 
 def report(name, steps=None, log=print):
     """The three runs of one case and their figures: {label: {figure: value}}."""
-    from deme_gpu_check import fn_spread
+    from deme_fn_ring import fn_spread
     from pyref import Simulation
     from stickslip import analysis, columns
     from stickslip import scene as scene_mod

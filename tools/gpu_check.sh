@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # The DEM-Engine check, on a machine with an NVIDIA GPU and python3 3.12 (no network needed):
 #
 #   bash tools/gpu_check.sh BUNDLE [JIT_CACHE] [deme_gpu_check.py options]
@@ -6,7 +7,7 @@
 # BUNDLE: deme-bundle.tar.xz, DEM-Engine 3.0.19 (PyPI deme) with the CUDA 12.8 runtime, NVRTC
 # and headers it compiles with (~39 MB; made where PyPI can be reached by tools/deme_bundle.sh). JIT_CACHE: a jit-cache.tar.xz an earlier run left in $OUT (its
 # compiled kernels: a second run skips minutes of compiling), or "" for none.
-# Unpacks the bundle under /tmp/gpu_check, links its share/, include/ and lib64/ into the
+# Unpacks the bundle under $TMPDIR/gpu_check (/tmp by default), links its share/, include/ and lib64/ into the
 # interpreter's purelib folder (DEM-Engine looks for its kernel sources there), then runs
 # tools/deme_gpu_check.py: the contract rows on the GPU against the CPU shim, drag and tilt
 # against pyref, and the bench (stick-slip against the engine's own frictional Hertz-Mindlin).
@@ -17,7 +18,7 @@ BUNDLE=${1:?usage: gpu_check.sh BUNDLE [JIT_CACHE] [options]}
 CACHE=${2:-}
 shift $(( $# >= 2 ? 2 : 1 ))
 OUT=${OUT:-$PWD/gpu_check_out}
-W=/tmp/gpu_check
+W=${TMPDIR:-/tmp}/gpu_check
 mkdir -p "$OUT" "$W"
 export OUT PYTHONUNBUFFERED=1
 t0=$(date +%s)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
 # The whole GPU check in one command on a lent GPU machine, which runs one command of at most
 # 600 s, sends back at most 8 files, and is given back after ~30 s idle (a second command
 # would start a fresh one):
@@ -25,7 +26,7 @@ OUT="$OUT/check" bash tools/gpu_check.sh "$BUNDLE" "$CACHE" --parts contract dra
     --deadline 280 --tilt-every 50
 first=$?
 [ "$first" -eq 2 ] && exit 2  # no engine here (gpu_check.sh said why): the bench cannot run either
-# the bundle stays unpacked and the compiled kernels stay in /tmp/gpu_check/jit: no cache to give
+# the bundle stays unpacked and the compiled kernels stay in gpu_check.sh's work folder: no cache to give
 OUT="$OUT/bench" bash tools/gpu_check.sh "$BUNDLE" "" --parts bench --rounds 20 --bench-steps 500 \
     --settle-steps 6000 --cd-freq 20 --control --deadline 290
 second=$?

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Does a LAMMPS `read_restart` run write the split run's bytes on a pile that LAMMPS' own
 processor grid splits (docs/testing.md, History, "LAMMPS restarts")? tests/test_lammps_restart.py
 pins the test pile, split along x; this measures other piles, split where LAMMPS chooses.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Dumps for checking that a speed change of the LAMMPS plugin changes no output digit:
 in.pour (pour 6000 + chute 2000 steps, dampflag 1 unless said) in all 8 compiled modes
 (slip_timing step/exact x history_rotation project/keep_length x record no/yes, mu_k 0.45

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Dumps for checking that a speed change of the LIGGGHTS plugin changes no output digit
 (issue 32): the benchmark's packing (liggghts_bench, 100 + 300 steps, every grain-grain
 and floor contact) in all 8 compiled modes of the law (exact_slip_timing off/on x
@@ -17,7 +18,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-from stickslip.bench import liggghts as b  # noqa: E402
+from stickslip.bench import liggghts_runs as b  # noqa: E402
 from speed_dump_runs import run_cases  # noqa: E402
 
 if len(sys.argv) != 3:
@@ -44,7 +45,7 @@ def packing(extra, rec=False, pair_only=""):
     """The benchmark's timed script, 100 steps then 300 with dumps every 100; `pair_only`
     settings for the grain pairs alone (LIGGGHTS' normal model crashes on a primitive wall
     with computeElasticPotential on, stock history's as ours)."""
-    t = b.TIMED.format(data=b._packing(), warm=100, timed=DUMP.format(every=100) + "run 300\n")
+    t = b.TIMED.format(data=b.packing(), warm=100, timed=DUMP.format(every=100) + "run 300\n")
     if rec:  # (LIGGGHTS wants the compute before the first run)
         t = t.replace("compute c all contact/atom", REC.format(every=100) + "compute c all contact/atom")
     pair = "tangential ${tang} absolute_damping on limitForce on ${extra}\npair_coeff"
@@ -78,4 +79,4 @@ cases["pour-step"] = pour("exact_slip_timing off")
 cases["pour-exact"] = pour("exact_slip_timing on")
 
 
-run_cases(cases, out, [exe, "-log", "none", "-echo", "none"], b._env())
+run_cases(cases, out, [exe, "-log", "none", "-echo", "none"], b.env())

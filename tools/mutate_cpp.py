@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Small deliberate bugs in the C++ law, each built and run against the tests: does the
 suite see it? (issue 31 item 5; the README's test section quotes the last result.)
 
@@ -61,6 +62,7 @@ class Engine:
     wide: tuple  # the engine's default-suite tests, for mutants the fast one misses
     mutants: tuple
     cmake_args: tuple = ()  # configure arguments beyond the build type
+    builder: object = None  # build(src, out, quick, cmake_args) for an engine built otherwise (None: cmake -S src)
 
 
 def exact_path_mutants(file=""):
@@ -295,7 +297,98 @@ DEME_MUTANTS = (
            "<= 1e-4 * ss_rad) {", "<= 1e30 * ss_rad) {"),
 )
 
+# LAMMPS 2025's sub-model: lammps_plugin/granular/gran_sub_mod_tangential_stick_slip.cpp (steps
+# 3-5, E0) and exact_slip_timing.h (E1-E7), compiled into LAMMPS (build_lammps_2025).
+SUB_CPP, SUB_H = "gran_sub_mod_tangential_stick_slip.cpp", "gran_sub_mod_tangential_stick_slip.h"
+LAMMPS_GRANULAR_MUTANTS = (
+    Mutant("fmin_0.3pct", "Fmin off by 0.3 %",
+           "const double fmin = fncrit * kin;", "const double fmin = fncrit * kin * 1.003;", count=2),
+    Mutant("threshold_gt_step", "> for >= at the threshold",
+           "bool slipped = magfs >= Fscrit;", "bool slipped = magfs > Fscrit;"),
+    Mutant("threshold_gt_exact_start", "> for >= at the threshold",
+           "slipped = slipped || lensq3(start) >= Fscrit * Fscrit;", "slipped = slipped || lensq3(start) > Fscrit * Fscrit;"),
+    Mutant("threshold_gt_exact_loop", "> for >= at the threshold",
+           "if (slips == 0 && F2 >= T * T)", "if (slips == 0 && F2 > T * T)", file=EXACT_H),
+    Mutant("reset_spring_sign", "sign error in the spring reset",
+           "scale3(-1.0 / ks, history);", "scale3(1.0 / ks, history);"),
+    Mutant("reset_total_sign", "sign error in the spring reset",
+           "if (TOTAL) add3(history, temp, history);", "if (TOTAL) sub3(history, temp, history);"),
+    Mutant("reset_exact_end_sign", "sign error in the spring reset",
+           "history[i] = -(trial[i] + temp[i]) / ks;", "history[i] = -(trial[i] - temp[i]) / ks;"),
+    Mutant("dashpot_sign", "sign error in the dashpot",
+           "// eq. 5: the trial force, spring + dashpot scale3(-ks, history, gm->fs); scale3(damp, gm->vtr, temp); "
+           "sub3(gm->fs, temp, gm->fs);",
+           "// eq. 5: the trial force, spring + dashpot scale3(-ks, history, gm->fs); scale3(damp, gm->vtr, temp); "
+           "add3(gm->fs, temp, gm->fs);"),
+    Mutant("exact_start_sign", "sign error in the trial force at the step's start (exact timing)",
+           "sub3(start, temp, start);", "add3(start, temp, start);"),
+    Mutant("turn_loses_length", "a turned history that loses its length",
+           "scale3(prjmag > 0 ? shrmag / prjmag : 0, history);", ""),
+    Mutant("exact_misses_whole_cycles", "exact timing that misses a slip inside the step",
+           "const double n = std::floor(rest / L);", "const double n = 0.0;", file=EXACT_H),
+    Mutant("exact_misses_slip_at_start", "exact timing that misses a slip inside the step",
+           "slipped = slipped || lensq3(start) >= Fscrit * Fscrit;", "slipped = slipped;"),
+    Mutant("exact_slip_late", "exact timing that misses a slip inside the step",
+           "dtheta = rate > 0.0 ? gap / rate : INFINITY;", "dtheta = rate > 0.0 ? 1.5 * gap / rate : INFINITY;",
+           file=EXACT_H),
+    Mutant("reset_total_ignored_step", "the reset rule `total` ignored",
+           "if (TOTAL) add3(history, temp, history);", ""),
+    Mutant("reset_total_ignored_exact", "the reset rule `total` ignored",
+           "const double kept = reset_total ? 0.0 : nu_s * speed;", "const double kept = nu_s * speed;", file=EXACT_H),
+    Mutant("total_name_wrong_class", "the reset rule `total` ignored",
+           "GranSubModStyle(stick_slip/total,GranSubModTangentialStickSlipTotal,TANGENTIAL);",
+           "GranSubModStyle(stick_slip/total,GranSubModTangentialStickSlipPlain,TANGENTIAL);", file=SUB_H),
+    Mutant("exact_name_wrong_class", "exact timing that misses a slip inside the step",
+           "GranSubModStyle(stick_slip/exact/record,GranSubModTangentialStickSlipExactRecord,TANGENTIAL);",
+           "GranSubModStyle(stick_slip/exact/record,GranSubModTangentialStickSlipRecord,TANGENTIAL);", file=SUB_H),
+    Mutant("flow_ignores_reset_total", "the reset rule `total` ignored",
+           "const bool flow_law = ratio == 1.0 && (TOTAL || damp == 0.0);",
+           "const bool flow_law = ratio == 1.0 && damp == 0.0;"),
+    Mutant("slip_counted_twice", "a wrong slip count in the record",
+           "if (slipped) history[HIST_NSLIP] += 1.0;", "if (slipped) history[HIST_NSLIP] += 2.0;"),
+    Mutant("record_fn_unsigned_damping", "the record's Fn not the one applied",
+           "history[HIST_FN] = gm->Fntot;", "history[HIST_FN] = gm->Fnormal;"),
+    Mutant("mixed_mu_from_one_side", "a per-type-pair coefficient read from the wrong pair",
+           "coeffs[i] = mix_geom(icoeffs[i], jcoeffs[i]);", "coeffs[i] = mix_geom(icoeffs[i], icoeffs[i]);"),
+    Mutant("slips_negated_across", "a wrong slip count in the record",
+           "transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP] = transfer_history_factor[HIST_WORK]",
+           "transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_WORK]"),
+    Mutant("work_negated_across", "a wrong dissipated work in the record",
+           "transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP] = transfer_history_factor[HIST_WORK]",
+           "transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP]"),
+    Mutant("history_transfer_default", "the spring seen from the other grain with the record's values negated",
+           "nondefault_history_transfer = 1;", "nondefault_history_transfer = 0;"),
+) + exact_path_mutants(EXACT_H)
+
+
+def build_lammps_2025(src: Path, out: Path, quick=True, cmake_args=()):
+    """The sub-model's files in `src` compiled into a copy of LAMMPS 2025's source (made once
+    beside `out` from ./run.sh setup's, build/lammps_2025/source), built in `out`: Release
+    always (after the first build a mutant recompiles one file and relinks, ~10 s)."""
+    lammps = out.parent / "lammps-source"
+    if not (lammps / ".complete").exists():
+        shutil.rmtree(lammps, ignore_errors=True)
+        shutil.copytree(REPO / "build" / "lammps_2025" / "source", lammps)
+    for f in src.iterdir():
+        target = lammps / "src" / "GRANULAR" / f.name
+        if not target.exists() or target.read_bytes() != f.read_bytes():
+            shutil.copy(f, target)
+    if not (out / "CMakeCache.txt").exists():
+        subprocess.run(["cmake", "-S", str(lammps / "cmake"), "-B", str(out), "-C",
+                        str(lammps / "cmake" / "presets" / "all_off.cmake"), "-D", "PKG_GRANULAR=on", "-D", "PKG_PLUGIN=on",
+                        "-D", "BUILD_MPI=on", "-D", "BUILD_SHARED_LIBS=on", "-D", "LAMMPS_EXCEPTIONS=on",
+                        "-D", "BUILD_OMP=off", "-D", "CMAKE_BUILD_TYPE=Release"], check=True, capture_output=True)
+    proc = subprocess.run(["cmake", "--build", str(out), "-j", "2"], capture_output=True, text=True)
+    return proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+
+
 ENGINES = {
+    "lammps_granular": Engine(
+        source="lammps_plugin/granular", law_file=SUB_CPP, build_env="STICKSLIP_LAMMPS_2025",
+        fast=("tests/test_law_contract.py", "-k", "lammps_granular"),
+        wide=("tests/test_lammps_granular.py", "tests/test_lammps_granular_dropin.py",
+              "tests/test_lammps_granular_restart.py"),
+        mutants=LAMMPS_GRANULAR_MUTANTS, builder=build_lammps_2025),
     "liggghts": Engine(
         source="liggghts_plugin", law_file="tangential_model_stick_slip.h", build_env="STICKSLIP_LIGGGHTS_BUILD",
         fast=("tests/test_law_contract.py", "-k", "liggghts"),
@@ -305,10 +398,10 @@ ENGINES = {
         mutants=LIGGGHTS_MUTANTS),
     "lammps": Engine(
         source="lammps_plugin", law_file=LAW_H, build_env="STICKSLIP_LAMMPS_BUILD",
-        fast=("tests/test_law_contract.py", "-k", "lammps"),
+        fast=("tests/test_law_contract.py", "-k", "lammps and not lammps_granular"),
         wide=("tests/test_lammps_plugin.py", "tests/test_lammps_engine.py", "tests/test_lammps_dropin.py",
               "tests/test_lammps_mpi.py", "tests/test_lammps_region_wall.py", "tests/test_lammps_restart.py",
-              "tests/test_stability_engines.py", "tests/test_translating_wall.py", "-k", "lammps"),
+              "tests/test_stability_engines.py", "tests/test_translating_wall.py", "-k", "lammps and not lammps_granular"),
         mutants=LAMMPS_MUTANTS,
         # the LAMMPS headers ./run.sh setup extracted (CMakeLists' default is relative to its source)
         cmake_args=(f"-DLAMMPS_HEADERS={REPO / 'build' / 'lammps_headers' / 'src'}",)),
@@ -334,7 +427,7 @@ def apply(source: str, m: Mutant) -> str:
     return pattern(m.find).sub(lambda _: m.replace, source)
 
 
-def build(src: Path, out: Path, quick=True, cmake_args=()):
+def build_with_cmake(src: Path, out: Path, quick=True, cmake_args=()):
     """Configure (once) and build `src` into `out`: -O0 (quick) or Release."""
     if not (out / "CMakeCache.txt").exists():
         kind = ["-DCMAKE_BUILD_TYPE=MutantO0", "-DCMAKE_CXX_FLAGS_MUTANTO0=-O0"] if quick else \
@@ -365,6 +458,9 @@ def main(argv=None):
     mutants = [m for m in eng.mutants if not args.only or m.id in args.only]
     work = REPO / "build" / "mutants" / args.engine
     src, out, out_release = work / "src", work / "build", work / "build-release"
+    if eng.builder is not None:  # (one build serves both selections)
+        out_release = out
+    build = eng.builder or build_with_cmake
     if src.exists():
         shutil.rmtree(src)
     shutil.copytree(REPO / eng.source, src)

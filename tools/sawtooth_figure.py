@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The README's picture: the drag case's friction saw-tooth (paper section 3.1, Fig. 9),
 |F_s|/Fn against time, between mu_s and 2 mu_k - mu_s with mean mu_k.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """What the speed-dump scripts (liggghts_speed_dumps.py, lammps_speed_dumps.py) share: run
 each case's input script in its own folder of OUT, two at a time, print one line per case,
 and exit with status 1 if any failed."""

@@ -1,8 +1,9 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The test suite's CPU profile from a STICKSLIP_TEST_CPU log (docs/testing.md): the total,
 what two cores would take at best, the files and the tests that cost most.
 
-    STICKSLIP_TEST_CPU=/tmp/cpu.txt ./run.sh test
-    .venv/bin/python tools/test_cpu_profile.py /tmp/cpu.txt [--top 15]
+    STICKSLIP_TEST_CPU=$PWD/cpu.txt ./run.sh test
+    .venv/bin/python tools/test_cpu_profile.py cpu.txt [--top 15]
 """
 import argparse
 import collections

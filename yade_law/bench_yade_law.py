@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Cost of the Python stick-slip law against YADE's native frictional law, same run.
 
     yade -n -x bench_yade_law.py [--n 20] [--steps 30] [--reps 5] [--no-rotation] [--shake V]

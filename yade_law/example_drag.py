@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The paper's case 1 (section 3.1) in YADE: a grain dragged at constant speed on a floor.
 
     yade -n -x example_drag.py [--reset spring|total] [--csv out.csv] [--steps 2500]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Run one stickslip scene in YADE: `yade -n -x run_scene.py scene.json out.csv`.
 
 Knows only YADE and the scene dict written by stickslip/adapters/yade.py (masses are

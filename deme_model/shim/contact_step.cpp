@@ -1,4 +1,5 @@
-/* stickslip: deme_model/stick_slip.cu compiled on the CPU, one contact and one step per call,
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   stickslip: deme_model/stick_slip.cu compiled on the CPU, one contact and one step per call,
    for tests/deme_shim.py (ctypes). Each function below declares the variables DEM-Engine's
    force kernel gives a custom force model (the same names and types), includes the model's
    text with one set of its options, and hands back what the model wrote.

@@ -1,4 +1,5 @@
-/* stickslip: the few names of DEM-Engine's force kernels that deme_model/stick_slip.cu uses,
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   stickslip: the few names of DEM-Engine's force kernels that deme_model/stick_slip.cu uses,
    for the CPU (g++), so that the same file is compiled and run on a machine without a GPU
    (tests/deme_shim.py). Written from DEM-Engine 3.0.19's kernel sources, by signature:
    float3/float4/double3 and make_float3/make_float4 (CUDA's vector types), the arithmetic of its

@@ -1,4 +1,5 @@
-/* stickslip: the layout of the flat arrays contact_step.cpp's functions take; tests/deme_shim.py
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   stickslip: the layout of the flat arrays contact_step.cpp's functions take; tests/deme_shim.py
    reads these numbers from this file, so that the two cannot differ. */
 
 #ifndef STICKSLIP_DEME_SHIM_LAYOUT_H

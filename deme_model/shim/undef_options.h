@@ -1,4 +1,5 @@
-/* stickslip: forget the options of deme_model/stick_slip.cu after one build of it
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   stickslip: forget the options of deme_model/stick_slip.cu after one build of it
    (contact_step.cpp builds it several times, each with its own options). No include
    guard: it is meant to be included again. */
 #undef STICKSLIP_HOOKE

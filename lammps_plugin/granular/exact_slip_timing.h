@@ -1,4 +1,5 @@
-/* stickslip: exact slip timing of the stick-slip law of Khellaf & Mansouri (2024),
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   stickslip: exact slip timing of the stick-slip law of Khellaf & Mansouri (2024),
    docs/law.md "Exact slip timing", steps E1-E7, for one contact and one step.
 
    Engine-independent (no LAMMPS or LIGGGHTS header): plain doubles and 3-vectors, so

@@ -1,4 +1,5 @@
-/* ----------------------------------------------------------------------
+/* SPDX-License-Identifier: GPL-2.0-or-later
+   ----------------------------------------------------------------------
    stickslip: the stick-slip tangential law of Khellaf & Mansouri (2024) as a tangential
    sub-model of LAMMPS' granular model (docs/law.md; equation numbers are the paper's).
 
@@ -14,12 +15,14 @@
 
 #include "gran_sub_mod_tangential_stick_slip.h"
 
+#include "comm.h"
 #include "error.h"
 #include "exact_slip_timing.h"
 #include "gran_sub_mod_damping.h"
 #include "gran_sub_mod_normal.h"
 #include "granular_model.h"
 #include "math_extra.h"
+#include "stickslip_version.h"
 
 #include <cmath>
 #include <string>
@@ -35,37 +38,27 @@ static constexpr double EPSILON = 1e-10;
 
 /* ---------------------------------------------------------------------- */
 
-GranSubModTangentialStickSlip::GranSubModTangentialStickSlip(GranularModel *gm, LAMMPS *lmp) :
-    GranSubModTangential(gm, lmp), xt(0.0), kin(0.0), ratio(1.0), mindlin(false), reset_total(false),
-    exact(false), record(false)
+GranSubModTangentialStickSlip::GranSubModTangentialStickSlip(GranularModel *gm, LAMMPS *lmp, bool total,
+                                                             bool exact, bool record) :
+    GranSubModTangential(gm, lmp), reset_total(total), exact(exact), record(record), xt(0.0), kin(0.0), ratio(1.0),
+    mindlin(false)
 {
   num_coeffs = 4;
-  size_history = SIZE_PLAIN;
-}
-
-/* ----------------------------------------------------------------------
-   the options from the name the input gave (the header's GranSubModStyle lines):
-   stick_slip[/total][/exact][/record]
-------------------------------------------------------------------------- */
-
-void GranSubModTangentialStickSlip::read_options()
-{
-  reset_total = name.find("/total") != std::string::npos;
-  exact = name.find("/exact") != std::string::npos;
-  record = name.find("/record") != std::string::npos;
-
   size_history = record ? SIZE_RECORD : SIZE_PLAIN;
   nsvector = record ? NRECORD : 0;
-  // seen from the other body of a pair, D and F_s change sign; Fn, the slip count and the
-  // work do not
-  delete[] transfer_history_factor;
-  transfer_history_factor = nullptr;
-  nondefault_history_transfer = record ? 1 : 0;
   if (record) {
+    // seen from the other body of a pair, D and F_s change sign; Fn, the slip count and the
+    // work do not
+    nondefault_history_transfer = 1;
     transfer_history_factor = new double[SIZE_RECORD];
     for (int i = 0; i < SIZE_RECORD; i++) transfer_history_factor[i] = -1.0;
     transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP] = transfer_history_factor[HIST_WORK] = 1.0;
   }
+  // the version, once a process, where LAMMPS writes its own start-up lines
+  static bool said = false;
+  if (!said && comm->me == 0)
+    utils::logmesg(lmp, "stickslip " STICKSLIP_VERSION ": tangential sub-model stick_slip (Khellaf & Mansouri 2024)\n");
+  said = true;
 }
 
 /* ----------------------------------------------------------------------
@@ -75,7 +68,6 @@ void GranSubModTangentialStickSlip::read_options()
 
 void GranSubModTangentialStickSlip::coeffs_to_local()
 {
-  read_options();
   const double ks = coeffs[0], mu_k = coeffs[3];
   xt = coeffs[1];
   mu = coeffs[2];
@@ -138,38 +130,21 @@ void GranSubModTangentialStickSlip::report_record(const double *history)
 }
 
 /* ----------------------------------------------------------------------
-   docs/law.md steps 3-5 (and E0-E7 with /exact) at one contact for one force evaluation
+   docs/law.md steps 3-5 (and E0-E7 with EXACT) at one contact for one force evaluation
 ------------------------------------------------------------------------- */
 
-void GranSubModTangentialStickSlip::calculate_forces()
+template <bool TOTAL, bool EXACT, bool RECORD> void GranSubModTangentialStickSlip::step()
 {
   double temp[3];
   damp = xt * gm->damping_model->get_damp_prefactor();    // nu_s
   const double fncrit = gm->normal_model->get_fncrit();      // |Fn| (adhesive models: their own)
   const double Fscrit = fncrit * mu;                         // T = mu_s |Fn|
-  const double fmin = fncrit * kin;                          // Fmin (eq. 8)
   const double ks = mindlin ? k * gm->contact_radius : k;
   double *history = &gm->history[history_index];
+  const double before2 = RECORD ? lensq3(history) : 0.0;
 
-  if (gm->contact_type == PAIR && gm->calculate_svector) {
-    // pair granular's single() (compute pair/local): report, change nothing
-    if (record) {
-      copy3(&history[HIST_FS], gm->fs);
-      report_record(history);
-    } else {
-      // the force the law would apply now, with no time passing
-      scale3(-ks, history, gm->fs);
-      scale3(damp, gm->vtr, temp);
-      sub3(gm->fs, temp, gm->fs);
-      const double magfs = len3(gm->fs);
-      if (magfs >= Fscrit) scale3(magfs > 0.0 && lensq3(history) != 0.0 ? fmin / magfs : 0.0, gm->fs);
-    }
-    return;
-  }
-
+  double turned[3];    // D before the step's increment (the exact timing's start)
   const bool update = gm->history_update;    // false: a set-up evaluation, no time passes
-  const double before2 = record ? lensq3(history) : 0.0;
-
   if (update) {
     // step 3: turn D into the current tangent plane keeping its length (linear_history's
     // arithmetic)
@@ -181,13 +156,27 @@ void GranSubModTangentialStickSlip::calculate_forces()
       const double prjmag = len3(history);
       scale3(prjmag > 0 ? shrmag / prjmag : 0, history);
     }
-  }
-  double turned[3];    // D before the step's increment (the exact timing's start)
-  if (exact) copy3(history, turned);
-  if (update) {
+    if (EXACT) copy3(history, turned);
     // eq. 7: D += V_s dt
     scale3(gm->dt, gm->vtr, temp);
     add3(history, temp, history);
+  } else {
+    if (gm->contact_type == PAIR && gm->calculate_svector) {
+      // pair granular's single() (compute pair/local): report, change nothing
+      if (RECORD) {
+        copy3(&history[HIST_FS], gm->fs);
+        report_record(history);
+      } else {
+        // the force the law would apply now, with no time passing
+        scale3(-ks, history, gm->fs);
+        scale3(damp, gm->vtr, temp);
+        sub3(gm->fs, temp, gm->fs);
+        const double magfs = len3(gm->fs);
+        if (magfs >= Fscrit) scale3(magfs > 0.0 && lensq3(history) != 0.0 ? fncrit * kin / magfs : 0.0, gm->fs);
+      }
+      return;
+    }
+    if (EXACT) copy3(history, turned);
   }
 
   // eq. 5: the trial force, spring + dashpot
@@ -198,7 +187,7 @@ void GranSubModTangentialStickSlip::calculate_forces()
   // step 5: slip if |F_t| >= mu_s |Fn|
   const double magfs = len3(gm->fs);
   bool slipped = magfs >= Fscrit;
-  if (exact) {
+  if (EXACT) {
     // E0: |F| moves on a line in the step and is convex, so the step has no slip iff the
     // trial force is below T at both ends; then the result is the step timing's. The
     // trial force at the start holds the spring before its increment.
@@ -208,10 +197,11 @@ void GranSubModTangentialStickSlip::calculate_forces()
     slipped = slipped || lensq3(start) >= Fscrit * Fscrit;
     if (slipped) {
       // E1-E7 (exact_slip_timing.h); E6 when nothing is added at a reset
-      const bool flow_law = ratio == 1.0 && (reset_total || damp == 0.0);
+      const double fmin = fncrit * kin;    // Fmin (eq. 8)
+      const bool flow_law = ratio == 1.0 && (TOTAL || damp == 0.0);
       double applied[3], trial[3], stick;
-      stickslip::exact_slips(start, gm->vtr, Fscrit, fmin, ratio, ks, damp, update ? gm->dt : 0.0, reset_total,
-                             flow_law, applied, trial, stick);
+      stickslip::exact_slips(start, gm->vtr, Fscrit, fmin, ratio, ks, damp, update ? gm->dt : 0.0, TOTAL, flow_law,
+                             applied, trial, stick);
       copy3(applied, gm->fs);
       // the spring holds the trial force at the end less the dashpot (eq. 5)
       for (int i = 0; i < 3; i++) history[i] = -(trial[i] + temp[i]) / ks;
@@ -220,9 +210,10 @@ void GranSubModTangentialStickSlip::calculate_forces()
     if (len3(history) != 0.0) {
       // the force drops to Fmin along the trial force; eq. 8 resets the spring to hold
       // Fmin alone, or with /total spring + dashpot (linear_history's rescale)
+      const double fmin = fncrit * kin;    // Fmin (eq. 8)
       const double scale = magfs > 0.0 ? fmin * (1.0 / magfs) : 0.0;
       scale3(scale, gm->fs, history);
-      if (reset_total) add3(history, temp, history);
+      if (TOTAL) add3(history, temp, history);
       scale3(-1.0 / ks, history);
       scale3(scale, gm->fs);
     } else {
@@ -232,7 +223,7 @@ void GranSubModTangentialStickSlip::calculate_forces()
     }
   }
 
-  if (record) {
+  if (RECORD) {
     if (update) {
       // docs/law.md "Energy": the work the contact received, -F_s.V_s dt, less the increase
       // of the spring energy Ks |D|^2/2
@@ -244,3 +235,25 @@ void GranSubModTangentialStickSlip::calculate_forces()
     if (gm->calculate_svector) report_record(history);    // (walls with per-atom output)
   }
 }
+
+/* ---------------------------------------------------------------------- */
+
+template <bool TOTAL, bool EXACT, bool RECORD>
+void GranSubModTangentialStickSlipWith<TOTAL, EXACT, RECORD>::calculate_forces()
+{
+  this->template step<TOTAL, EXACT, RECORD>();
+}
+
+// the eight names of the header
+namespace LAMMPS_NS {
+namespace Granular_NS {
+  template class GranSubModTangentialStickSlipWith<false, false, false>;
+  template class GranSubModTangentialStickSlipWith<false, false, true>;
+  template class GranSubModTangentialStickSlipWith<false, true, false>;
+  template class GranSubModTangentialStickSlipWith<false, true, true>;
+  template class GranSubModTangentialStickSlipWith<true, false, false>;
+  template class GranSubModTangentialStickSlipWith<true, false, true>;
+  template class GranSubModTangentialStickSlipWith<true, true, false>;
+  template class GranSubModTangentialStickSlipWith<true, true, true>;
+}    // namespace Granular_NS
+}    // namespace LAMMPS_NS

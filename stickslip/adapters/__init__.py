@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Engine adapters: each turns a validated scene into the standard time series.
 
 An adapter is a module `stickslip/adapters/<engine>.py` that satisfies `Adapter`

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Adapter for DEM-Engine (PyPI `deme`, Project Chrono's GPU DEM) with the force model of
 deme_model/ (the law in deme_model/stick_slip.cu, attached by deme_model/stickslip_deme.py).
 
@@ -28,27 +29,29 @@ gravity, or spin in 2D.
 """
 from __future__ import annotations
 
+import importlib
 import importlib.util
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 
-from .. import columns
+from .. import columns, shipped
 from . import RunResult
 
 NAME = "deme"
-REPO = Path(__file__).resolve().parents[2]
-MODEL_DIR = REPO / "deme_model"
 GRAIN_FAMILY0 = 1  # grain k is family 1 + k
 WALL_FAMILY0 = 200  # wall k is family 200 + k
 MAX_GRAINS = GRAIN_FAMILY0 + WALL_FAMILY0 - 2 - 1  # (families are 8-bit; the engine keeps 255)
 
 
 def helper():
-    """deme_model/stickslip_deme.py, loaded from its file (the folder is not a package)."""
-    spec = importlib.util.spec_from_file_location("stickslip_deme", MODEL_DIR / "stickslip_deme.py")
+    """deme_model/stickslip_deme.py: in a checkout loaded from its file (the folder is not a
+    package); a wheel installs it as a module of its own."""
+    path = shipped.CHECKOUT / "deme_model" / "stickslip_deme.py"
+    if not path.is_file():
+        return importlib.import_module("stickslip_deme")
+    spec = importlib.util.spec_from_file_location("stickslip_deme", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -73,8 +76,9 @@ def available():
         _import_deme()
     except Exception as e:  # (the wheel's CUDA libraries, a driver too old, ...)
         return f"`import deme` fails: {str(e).splitlines()[0] if str(e) else type(e).__name__}"
-    if not (MODEL_DIR / "stick_slip.cu").is_file():
-        return f"{MODEL_DIR / 'stick_slip.cu'} missing"
+    model = helper().MODEL_FILE
+    if not model.is_file():
+        return f"{model} missing"
     return None
 
 

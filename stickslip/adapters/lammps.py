@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Adapter for LAMMPS (Debian's package) with the stick-slip plugin (lammps_plugin/).
 
 Writes a LAMMPS input script for the scene (2D scenes with `dimension 2`; only the effects

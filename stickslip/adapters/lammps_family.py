@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """What the LIGGGHTS and LAMMPS adapters share (LIGGGHTS is a LAMMPS fork: same command
 line, same screen output, same input-script syntax for what both write): numbers written in
 full, the box around a scene, the run's folder, and running the script: serial or on MPI

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Adapter for LAMMPS as granular users build it today (2Aug2023 and later): `pair_style
 granular` and `fix wall/gran granular` with the tangential sub-model `stick_slip`
 (lammps_plugin/granular/, compiled into the LAMMPS 4 Feb 2025 that

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Adapter for LIGGGHTS 3.8 (Debian's package) with the stick_slip plugin.
 
 Writes a LIGGGHTS input script for the scene (2D scenes with `dimension 2`; only the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Adapter for pyref, the reference solver: runs in this process."""
 from __future__ import annotations
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The parts of a LAMMPS-family input script (LIGGGHTS is a LAMMPS fork: same variables,
 `if`, `jump` and `fix gravity`) that both adapters write the same way: a scene's gravity
 ramp as a control loop, and the bulk columns (columns.BULK, columns.RAMP) as a dump.

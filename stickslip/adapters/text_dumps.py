@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Text dumps of the LAMMPS family (LIGGGHTS is a LAMMPS fork and writes the same
 format): writing them at full precision, reading them back, and what both adapters compute
 from them (the slip statistics of columns.SLIP_STATS, group ranges of atom ids)."""

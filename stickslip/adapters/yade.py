@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Adapter for YADE (Debian's package): runs yade_law/run_scene.py in `yade -n -x`.
 
 YADE runs on the system Python, so the scene goes over as JSON (with the masses the
@@ -15,12 +16,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import columns
+from .. import columns, shipped
 from . import RunResult
 from . import missing
 
 NAME = "yade"
-RUNNER = Path(__file__).resolve().parents[2] / "yade_law" / "run_scene.py"
+RUNNER = shipped.path("yade_law/run_scene.py")
+# where YADE finds stickslip_yade: beside the runner in a checkout (yade_law/); a wheel
+# installs it as a package of its own, beside stickslip
+LAW_FOLDER = RUNNER.parent if (RUNNER.parent / "stickslip_yade").is_dir() else shipped.CHECKOUT
 
 
 def available():
@@ -68,7 +72,7 @@ def run(scene, out_dir, progress=None):
     t0 = time.perf_counter()
     wall, error = None, None
     with open(work / "yade.log", "w") as log:
-        env = dict(os.environ, STICKSLIP_YADE_LAW=str(RUNNER.parent))
+        env = dict(os.environ, STICKSLIP_YADE_LAW=str(LAW_FOLDER))
         p = subprocess.Popen(["yade", "-n", "-x", str(RUNNER), str(work / "scene.json"), str(csv_path)],
                              stdout=subprocess.PIPE, stderr=log, text=True, cwd=work, env=env)
         for line in p.stdout:

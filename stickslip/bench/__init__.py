@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Benchmarks and their tools: `stickslip bench` (table.py gathers the rows of pyref.py and of
 each engine's module: liggghts.py, lammps.py, yade.py), the per-path instruction counts of the
 C++ plugins (liggghts_paths.py, lammps_paths.py), and what they share: callgrind.py (reading

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Instruction counts from valgrind's callgrind: a cost figure that the machine's load
 does not move (the same binary on the same input executes the same instructions).
 

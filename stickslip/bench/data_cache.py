@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The benchmarks' starting states (a settled packing, a poured bed) as data files made once
 and kept: each is named by a hash of the input script that makes it, so a changed script
 makes a new one, and it is written under a temporary name first, so an interrupted build

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """LAMMPS rows for `stickslip bench`: what `pair_style gran/hooke/stickslip` costs against
 stock `gran/hooke/history`, and how it scales on 2 processes.
 
@@ -198,19 +199,28 @@ def _folder(work, name):
     return d
 
 
+def timed_run(d, script, cmd, probe=PROBE):
+    """Run `cmd` in folder d on the input `script` (written as in.timed), which runs
+    `shell ./probe.sh` right before and right after its timed steps: (the engine's on-CPU
+    seconds between the two, its output, the other processes' CPU during the run in cores).
+    `probe`: the probe for the engine's process name (proc_probe.py)."""
+    (d / "probe.sh").write_text(probe)
+    (d / "probe.sh").chmod(0o755)
+    (d / "probe.log").unlink(missing_ok=True)
+    (d / "in.timed").write_text(script)
+    out, foreign = _run(cmd, d)
+    marks = [int(x) for x in (d / "probe.log").read_text().split()]
+    if len(marks) != 2:
+        raise RuntimeError(f"{len(marks)} probe marks in {d} (expected 2)")
+    return (marks[1] - marks[0]) * 1e-9, out, foreign
+
+
 def _timed(data, config, work):
     """One overhead run: on-CPU seconds of the timed steps, pair contacts at their end, and
     the other processes' CPU during the run (cores)."""
     d = _folder(work, f"timed-{config}")
-    (d / "probe.sh").write_text(PROBE)
-    (d / "probe.sh").chmod(0o755)
-    (d / "probe.log").unlink(missing_ok=True)
-    (d / "in.timed").write_text(_script(data, STEPS, "shell ./probe.sh", "shell ./probe.sh"))
-    out, foreign = _run(_command(config), d)
-    marks = [int(x) for x in (d / "probe.log").read_text().split()]
-    if len(marks) != 2:
-        raise RuntimeError(f"{len(marks)} probe marks in {d} (expected 2)")
-    return {"cpu": (marks[1] - marks[0]) * 1e-9, "contacts": _contacts(out, WARM + STEPS), "foreign": foreign,
+    cpu, out, foreign = timed_run(d, _script(data, STEPS, "shell ./probe.sh", "shell ./probe.sh"), _command(config))
+    return {"cpu": cpu, "contacts": _contacts(out, WARM + STEPS), "foreign": foreign,
             "atoms": int(LOOP.findall(out)[-1][3])}
 
 
@@ -226,13 +236,23 @@ def _counted(data, config, work, steps=CALLGRIND_STEPS):
     """callgrind: instructions in the whole time step, in the pair style and in the wall, over
     `steps` steps."""
     d = _folder(work, f"callgrind-{config}")
-    (d / "in.timed").write_text(_script(data, steps, "shell ./callgrind_on.sh"))
-    profiles = callgrind.count(_command(config), d, env=_env(), on_request=True)
-    profile = profiles[-1]
+    k = counted_run(d, _script(data, steps, "shell ./callgrind_on.sh"), _command(config),
+                    {"pair": PAIR_FUNCTIONS, "wall": WALL_FUNCTIONS})
+    return dict(k, steps=steps)
+
+
+def counted_run(d, script, cmd, groups):
+    """callgrind on `cmd` in folder d, counting the steps after `script`'s (in.timed's)
+    `shell ./callgrind_on.sh`: {"total": the whole time step's instructions (Verlet::run),
+    and for each name of `groups` the own instructions of the functions whose names hold
+    one of its patterns}."""
+    (d / "in.timed").write_text(script)
+    profile = callgrind.count(cmd, d, env=_env(), on_request=True)[-1]
     costs = callgrind.self_costs(profile)
-    pair = sum(v for fn, v in costs.items() if any(p in fn for p in PAIR_FUNCTIONS))
-    wall = sum(v for fn, v in costs.items() if any(p in fn for p in WALL_FUNCTIONS))
-    return {"total": callgrind.total(profile), "pair": pair, "wall": wall, "steps": steps}
+    out = {name: sum(v for fn, v in costs.items() if any(p in fn for p in patterns))
+           for name, patterns in groups.items()}
+    out["total"] = callgrind.total(profile)
+    return out
 
 
 def _mpi(data, nproc, work):
@@ -266,14 +286,20 @@ def measure(rounds=ROUNDS, reps=3, counts=True, callgrind_steps=CALLGRIND_STEPS)
     return res
 
 
+def quiet_rounds(rounds):
+    """The rounds a ratio is taken over: those in which no run saw the other processes use
+    more than NOISY cores, if there are at least 3, else all; and the words that say which."""
+    quiet = [r for r in rounds if all(x["foreign"] <= NOISY for x in r.values())]
+    if len(quiet) >= 3:
+        return quiet, f"the {len(quiet)} quiet rounds of {len(rounds)}"
+    return rounds, f"{len(rounds)} rounds, {len(quiet)} of them quiet"
+
+
 def rows(res):
     """Rows for bench.csv/bench.md."""
     out = []
     rounds = res["rounds"]
-    quiet = [r for r in rounds if all(x["foreign"] <= NOISY for x in r.values())]
-    used = quiet if len(quiet) >= 3 else rounds
-    which = (f"the {len(used)} quiet rounds of {len(rounds)}" if used is quiet else
-             f"{len(rounds)} rounds, {len(quiet)} of them quiet")
+    used, which = quiet_rounds(rounds)
     atoms = rounds[0]["stock"]["atoms"]
     tag = f"in.pour's chute, {atoms} grains, {STEPS} steps, 1 process"
     for c in CONFIGS:

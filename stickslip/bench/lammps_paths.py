@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Where the LAMMPS plugin's instructions go per contact-step, on lammps_bench's chute
 (issue 30 item 5), next to stock gran/hooke/history + wall/gran on the same steps.
 
@@ -38,34 +39,39 @@ SOURCE = bench.ROOT / "lammps_plugin"
 LINES_BUILD = bench.ROOT / "build" / "lammps_plugin_lines"
 STEPS = 500
 
-# (file, statement) -> the path its instructions belong to
+# file -> {statement: the path its instructions belong to}
 MARKERS = {
-    ("pair_gran_hooke_stickslip.cpp", "const double radi = radius[i];"): "every grain i",
-    ("pair_gran_hooke_stickslip.cpp", "const int j = jlist[jj] & NEIGHMASK;"): "every neighbour",
-    ("pair_gran_hooke_stickslip.cpp", "touch[jj] = 0;"): "apart",
-    ("pair_gran_hooke_stickslip.cpp", "touch[jj] = 1;"): "touching",
-    ("pair_gran_hooke_stickslip.cpp", "torque[j][0] -= cj * tor1;"): "j owned (its force and torque)",
-    ("fix_wall_gran_stickslip.cpp", "if (!(mask[i] & bit)) continue;"): "every grain",
-    ("fix_wall_gran_stickslip.cpp", "for (int m = 0; m < dnum; m++) hist[i][m] = 0.0;"): "apart",
-    ("fix_wall_gran_stickslip.cpp", "double meff = rmass[i];"): "touching",
-    ("stick_slip_law.h", "const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;"):
-        "step: slip (reset to Fmin)",
-    ("stick_slip_law.h", "if (start2 >= limit * limit && limit > 0.0 && !s.reset_total"):
-        "exact: a slip in the step (E4 tested)",
-    ("stick_slip_law.h", "F[k] = -a * vtr[k];"): "exact: E4 at the step's start (slides)",
-    ("stick_slip_law.h", "exact_general(s, c, limit, fmin, v, nu_s, dt, f0, f, d);"): "exact: general case",
-    ("exact_slip_timing.h", "const double speed = std::sqrt(dot3(vs, vs));"): "exact_slips: every call",
-    ("exact_slip_timing.h", "applied[k] = 0.0;"): "E1 (Fn = 0)",
-    ("exact_slip_timing.h", "const double f = dot3(F, u), F2 = dot3(F, F);"): "E2 (next slip sought)",
-    ("exact_slip_timing.h", "for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];"):
-        "sticks to the step's end",
-    ("exact_slip_timing.h", "slips++;"): "E3 (a slip)",
-    ("exact_slip_timing.h", "trial[k] = (fmin + kept) * u[k];"): "E4 after a slip",
-    ("exact_slip_timing.h", "plastic_flow(F, u, rate * rest / T, T);"): "E6 (plastic flow)",
-    ("exact_slip_timing.h", "const double fu = dot3(F, u);"): "E5/E6/E7 tests",
-    ("exact_slip_timing.h", "const double n = std::floor(rest / L);"): "E7 (closed form)",
+    "pair_gran_hooke_stickslip.cpp": {
+        "const double radi = radius[i];": "every grain i",
+        "const int j = jlist[jj] & NEIGHMASK;": "every neighbour",
+        "touch[jj] = 0;": "apart",
+        "touch[jj] = 1;": "touching",
+        "torque[j][0] -= cj * tor1;": "j owned (its force and torque)",
+    },
+    "fix_wall_gran_stickslip.cpp": {
+        "if (!(mask[i] & bit)) continue;": "every grain",
+        "for (int m = 0; m < dnum; m++) hist[i][m] = 0.0;": "apart",
+        "double meff = rmass[i];": "touching",
+    },
+    "stick_slip_law.h": {
+        "const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;": "step: slip (reset to Fmin)",
+        "if (start2 >= limit * limit && limit > 0.0 && !s.reset_total": "exact: a slip in the step (E4 tested)",
+        "F[k] = -a * vtr[k];": "exact: E4 at the step's start (slides)",
+        "exact_general(s, c, limit, fmin, v, nu_s, dt, f0, f, d);": "exact: general case",
+    },
+    "granular/exact_slip_timing.h": {
+        "const double speed = std::sqrt(dot3(vs, vs));": "exact_slips: every call",
+        "applied[k] = 0.0;": "E1 (Fn = 0)",
+        "const double f = dot3(F, u), F2 = dot3(F, F);": "E2 (next slip sought)",
+        "for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];": "sticks to the step's end",
+        "slips++;": "E3 (a slip)",
+        "trial[k] = (fmin + kept) * u[k];": "E4 after a slip",
+        "plastic_flow(F, u, rate * rest / T, T);": "E6 (plastic flow)",
+        "const double fu = dot3(F, u);": "E5/E6/E7 tests",
+        "const double n = std::floor(rest / L);": "E7 (closed form)",
+    },
 }
-LAW_FILES = re.compile(r"lammps_plugin/(stick_slip_law\.h|exact_slip_timing\.h|wall_contact\.h|"
+LAW_FILES = re.compile(r"lammps_plugin/(stick_slip_law\.h|granular/exact_slip_timing\.h|wall_contact\.h|"
                        r"pair_gran_hooke_stickslip\.cpp|fix_wall_gran_stickslip\.cpp)$")
 STOCK = re.compile(r"PairGranHookeHistory::compute|FixWallGran::(post_force|hooke_history)")
 
@@ -106,11 +112,13 @@ def _profile(config, steps, launcher, work):
 def marker_lines():
     """{(file, line): path name} of MARKERS in the current source; refuses a missing one."""
     out = {}
-    for (name, statement), path in MARKERS.items():
-        lines = [k + 1 for k, text in enumerate((SOURCE / name).read_text().splitlines()) if statement in text]
-        if len(lines) != 1:
-            raise RuntimeError(f"marker of '{path}' found {len(lines)} times in lammps_plugin/{name}: {statement}")
-        out[(name, lines[0])] = path
+    for name, marks in MARKERS.items():
+        source = (SOURCE / name).read_text().splitlines()
+        for statement, path in marks.items():
+            lines = [k + 1 for k, text in enumerate(source) if statement in text]
+            if len(lines) != 1:
+                raise RuntimeError(f"marker of '{path}' found {len(lines)} times in lammps_plugin/{name}: {statement}")
+            out[(name, lines[0])] = path
     return out
 
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Where the stick_slip plugin's cost goes per contact-step, on the benchmark pour of
 liggghts_bench (issue 32), next to stock `tangential history` on the same contacts:
 
@@ -29,8 +30,8 @@ import tempfile
 from pathlib import Path
 
 from ..adapters.liggghts import BUILD, LAUNCHER
-from . import callgrind
-from . import liggghts as bench
+from . import callgrind, liggghts_runs
+from .liggghts import CALLGRIND_STEPS
 
 PATHS_BUILD = BUILD.parent / "liggghts_plugin_paths"
 LAW = re.compile(r"ContactModels::TangentialModel<\d+>::(surfacesIntersect|law<)|ContactModels::StickSlip::")
@@ -54,10 +55,10 @@ def path_counts(tang, steps, work):
     for n in (0, steps):
         d = work / f"paths-{tang}-{n}"
         d.mkdir(exist_ok=True)
-        (d / "in.timed").write_text(bench.TIMED.format(data=bench._packing(), warm=bench.WARM,
-                                                       timed=bench._single(n) if n else ""))
-        env = dict(bench._env(), STICK_SLIP_PATH_COUNTS=str(d / "paths.txt"))
-        subprocess.run(bench._command(tang, launcher=launcher), cwd=d, env=env, check=True, stdout=subprocess.DEVNULL)
+        liggghts_runs.write_timed(d, liggghts_runs.packing(), liggghts_runs.single(n) if n else "")
+        env = dict(liggghts_runs.env(), STICK_SLIP_PATH_COUNTS=str(d / "paths.txt"))
+        subprocess.run(liggghts_runs.command(tang, launcher=launcher), cwd=d, env=env, check=True,
+                       stdout=subprocess.DEVNULL)
         got.append({k: int(v) for k, v in (ln.split() for ln in (d / "paths.txt").read_text().splitlines())})
     return {k: got[1][k] - got[0][k] for k in got[1]}
 
@@ -66,10 +67,9 @@ def instruction_runs(tang, steps, work, launcher=LAUNCHER):
     """{function: {address: times run}} for the law's functions, callgrind over the window."""
     d = work / f"instr-{tang}"
     d.mkdir(exist_ok=True)
-    (d / "in.timed").write_text(bench.TIMED.format(data=bench._packing(), warm=bench.WARM,
-                                                   timed="shell ./callgrind_on.sh\n" + bench._single(steps)))
-    parts = callgrind.count(bench._command(tang, launcher=launcher), d, env=bench._env(), on_request=True,
-                            options=["--dump-instr=yes"])
+    liggghts_runs.write_timed(d, liggghts_runs.packing(), "shell ./callgrind_on.sh\n" + liggghts_runs.single(steps))
+    parts = callgrind.count(liggghts_runs.command(tang, launcher=launcher), d, env=liggghts_runs.env(),
+                            on_request=True, options=["--dump-instr=yes"])
     return callgrind.instruction_counts(parts[0], lambda f: bool(LAW.search(f)))
 
 
@@ -119,7 +119,7 @@ def stock_attribution(groups, walls):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="python -m stickslip.bench.liggghts_paths", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--steps", type=int, default=bench.CALLGRIND_STEPS, help="steps of the window after the warm-up")
+    ap.add_argument("--steps", type=int, default=CALLGRIND_STEPS, help="steps of the window after the warm-up")
     ap.add_argument("--launcher", type=Path, default=LAUNCHER,
                     help="the build whose instructions are counted (default: the plugin's build; the paths are "
                          "counted by the analysis build of this source, the same for any build that gives the "
@@ -127,7 +127,7 @@ def main(argv=None):
     a = ap.parse_args(argv)
     if a.steps < 1:
         ap.error("--steps must be >= 1")
-    bench._check()
+    liggghts_runs.check()
     if not callgrind.available():
         sys.stderr.write("liggghts_paths: valgrind not installed (apt-get install valgrind)\n")
         return 1
@@ -137,13 +137,14 @@ def main(argv=None):
             p = path_counts(tang, a.steps, work)
             calls = p["CALL_PAIR"] + p["CALL_WALL"]
             rows = attribute(_groups(instruction_runs(tang, a.steps, work, a.launcher.resolve())), _names(p))
-            print(f"\n{bench.LABEL[tang]}: steps {bench.WARM}-{bench.WARM + a.steps}, {calls} law calls "
+            warm = liggghts_runs.WARM
+            print(f"\n{liggghts_runs.LABEL[tang]}: steps {warm}-{warm + a.steps}, {calls} law calls "
                   f"({p['CALL_PAIR']} pair, {p['CALL_WALL']} wall)")
             print("  paths, runs per call:  " + ", ".join(f"{k} {v / calls:.4%}" for k, v in p.items()
                                                             if v and not k.startswith("CALL")))
             _print(rows, calls)
         groups = _groups(instruction_runs("history", a.steps, work))
-        print(f"\n{bench.LABEL['history']} (its own trajectory: its counts differ a little)")
+        print(f"\n{liggghts_runs.LABEL['history']} (its own trajectory: its counts differ a little)")
         _print(stock_attribution(groups, p["CALL_WALL"]), max(groups))
     return 0
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The shell probes the engine benchmarks run from inside an engine (its `shell` command).
 
 `shell` runs a script through sh, so the engine's process is an ancestor of the script,

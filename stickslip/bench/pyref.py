@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """pyref's performance figures for `stickslip bench`: cost per grain-step over packing sizes,
 what each effect costs, both slip timings. Every figure is a median over repetitions.
 """

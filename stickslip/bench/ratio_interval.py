@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The ratio of two costs measured in interleaved rounds, with its confidence interval.
 
 Each round times configuration A and configuration B one right after the other, so the

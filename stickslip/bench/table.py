@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`stickslip bench`: performance figures, measured side by side in one run, into
 bench.csv and bench.md.
 

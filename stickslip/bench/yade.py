@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """YADE rows for `stickslip bench`: yade_law/bench_yade_law.py run in `yade -n -x`, and the
 per-step cost of a two-grain scene through the runner (what `report` pays)."""
 from __future__ import annotations

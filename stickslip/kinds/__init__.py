@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Case kinds: what a scene's `[analysis] kind` means, one module per kind, and what kinds
 share: paper.py (what the paper says, checked), stick_resolution.py (how well a run
 resolved its stick phases).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Kind "drag" (paper §3.1, Fig. 9): a grain dragged at constant speed over a wall.
 
 Friction saw-tooth between mu_s*Fn and (2 mu_k - mu_s)*Fn, mean mu_k*Fn, period
@@ -96,8 +97,8 @@ def figures(out, runs):
     for (law, timing, eng), (sc, s, df) in runs.items():
         c, g = prefix(sc), sc.analysis["grain"]
         disp = (df[f"{g}_x"] - df[f"{g}_x"].iloc[0]) * 1e6
-        a.plot(disp, df[f"{c}_fs"], plotstyle.ENGINE_LINES[eng], label=eng)
-        b.plot(disp, disp - df[f"{c}_fs"] / sc.contact.ks * 1e6, plotstyle.ENGINE_LINES[eng], label=eng)
+        a.plot(disp, df[f"{c}_fs"], **plotstyle.line(eng), label=eng)
+        b.plot(disp, disp - df[f"{c}_fs"] / sc.contact.ks * 1e6, **plotstyle.line(eng), label=eng)
         fn, p = s["fn_mean_N"], sc.contact
     if fn is None:
         plt.close(fig)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Kind "drum": avalanches in a slowly turning drum (cases/drum.toml, docs/drum.md).
 
 From the recorded grains at each row, two measures of the surface's slope (degrees,
@@ -20,9 +21,13 @@ import math
 
 import numpy as np
 
+from .none import paper_statements, precision_figures  # noqa: F401 (the contract: neither, as kind none)
+from .relative import angle_errors
+
 NAME = "drum"
 NAMES = {"settle": "seconds"}  # avalanches that start before this time are not measured
 PRECISION_DURATION = None
+errors = angle_errors("_mean_deg")  # stickslip precision: the angles' relative errors
 COMPARISON_LAWS = ()
 REPORT_TIMINGS = ("step",)
 
@@ -187,11 +192,6 @@ def summarise(scene, df, theta=None, theta_c=None):
     return out
 
 
-def errors(scene, summary, df, ref_summary, ref_df):
-    return {k: abs(summary[f"{k}_mean_deg"] - ref_summary[f"{k}_mean_deg"]) / abs(ref_summary[f"{k}_mean_deg"])
-            for k in ("theta_start", "theta_stop")}
-
-
 def claims(scene):
     return [("avalanches", "avalanches measured"), ("theta_start_mean_deg", "mean theta_start (deg)"),
             ("theta_stop_mean_deg", "mean theta_stop (deg)")]
@@ -215,11 +215,3 @@ def figures(out, runs):
         ax.set_title(" ".join(str(k) for k in key))
         names.append(save(fig, out, f"drum_theta_{'_'.join(str(k) for k in key)}.png"))
     return names
-
-
-def precision_figures(out, runs):
-    return []
-
-
-def paper_statements(scene):
-    return []

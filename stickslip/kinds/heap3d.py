@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Kind "heap3d": the slope of a heap left on a plate (cases/heap3d.toml, docs/granular-3d.md).
 
 From the recorded grains at the last row: the plate is the scene's fixed grains (its
@@ -15,6 +16,7 @@ import math
 import numpy as np
 
 from .incline3d import base_surface
+from .none import paper_statements, precision_figures  # noqa: F401 (the contract: neither, as kind none)
 
 NAME = "heap3d"
 NAMES = {}
@@ -103,11 +105,3 @@ def figures(out, runs):
         ax.set_title(f"theta_heap {summary['theta_heap_deg']:.1f} deg")
         names.append(save(fig, out, f"heap3d_{'_'.join(str(k) for k in key)}.png"))
     return names
-
-
-def precision_figures(out, runs):
-    return []
-
-
-def paper_statements(scene):
-    return []

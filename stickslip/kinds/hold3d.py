@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Kind "hold3d": does a flowing bed of spheres stop at a held angle? (cases/incline3d_hold.toml,
 docs/granular-3d.md: theta_stop without a ramp's lag, as Weinhart et al. 2012 measured it).
 
@@ -21,6 +22,7 @@ import math
 import numpy as np
 
 from . import incline3d
+from .none import paper_statements, precision_figures  # noqa: F401 (the contract: neither, as kind none)
 
 NAME = "hold3d"
 NAMES = {"hold_phase": "phase"}
@@ -66,11 +68,3 @@ def claims(scene):
 def figures(out, runs):
     """Mean speed along the slope against time, one figure per run."""
     return incline3d.speed_figures(out, runs, NAME, lambda df: df["t"], "time")
-
-
-def precision_figures(out, runs):
-    return []
-
-
-def paper_statements(scene):
-    return []

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Kind "incline3d": the start and stop angles of a bed of spheres on a rough incline
 (cases/incline3d.toml, docs/granular-3d.md).
 
@@ -19,9 +20,13 @@ import math
 
 import numpy as np
 
+from .none import paper_statements, precision_figures  # noqa: F401 (the contract: neither, as kind none)
+from .relative import angle_errors
+
 NAME = "incline3d"
 NAMES = {"stop_phase": "phase", "start_phase": "phase"}
 PRECISION_DURATION = None
+errors = angle_errors("_deg")  # stickslip precision: the angles' relative errors
 COMPARISON_LAWS = ()
 REPORT_TIMINGS = ("step",)
 
@@ -80,11 +85,6 @@ def summarise(scene, df):
     return out
 
 
-def errors(scene, summary, df, ref_summary, ref_df):
-    return {k: abs(summary[f"{k}_deg"] - ref_summary[f"{k}_deg"]) / abs(ref_summary[f"{k}_deg"])
-            for k in ("theta_start", "theta_stop")}
-
-
 def claims(scene):
     return [("theta_stop_deg", "theta_stop (deg)"), ("theta_start_deg", "theta_start (deg)"),
             ("depth_at_stop", "bed depth at the stop (d)")]
@@ -114,11 +114,3 @@ def speed_figures(out, runs, prefix, x, xlabel, marks=lambda summary: ()):
         ax.set_ylabel("mean speed along the slope")
         names.append(save(fig, out, f"{prefix}_{'_'.join(str(k) for k in key)}.png"))
     return names
-
-
-def precision_figures(out, runs):
-    return []
-
-
-def paper_statements(scene):
-    return []

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Kind "none": a scene without headline figures (packings, benchmarks)."""
 NAME = "none"
 NAMES = {}

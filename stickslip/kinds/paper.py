@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The paper's statements beside ours: each kind lists what its section of the paper says
 that can be checked (or not), and how our summary figures check it.
 

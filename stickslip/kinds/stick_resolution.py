@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """How well a run resolved its stick phases, and the one warning when it did not.
 
 With the step-mode law a slip is tested once per step, so once Ks*|V_s|*dt is a fair

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Kind "tilt" (paper §3.3, Figs. 13-15): a grain on a plate tilted until tan(beta) = mu_s.
 
 First slip at tan(beta) = mu_s, then stick-slip, then steady sliding at Fmin.
@@ -133,10 +134,10 @@ def figures(out, runs):
     fig, (a, b) = plt.subplots(2, 1, figsize=(7, 7))
     for (law, timing, eng), (sc, s, df) in runs.items():
         c, angle = _prefix(sc), df[f"{sc.analysis['wall']}_angle"]
-        a.plot(df["t"], df[f"{c}_fs"], plotstyle.ENGINE_LINES[eng], label=f"|Fs| [{eng}]")
+        a.plot(df["t"], df[f"{c}_fs"], **plotstyle.line(eng), label=f"|Fs| [{eng}]")
         t_stop = df["t"][np.argmax(angle.to_numpy())]
         z = df["t"] >= t_stop - 0.005
-        b.plot(df["t"][z], df[f"{c}_fs"][z], plotstyle.ENGINE_LINES[eng], lw=0.7, label=eng)
+        b.plot(df["t"][z], df[f"{c}_fs"][z], **plotstyle.line(eng), lw=0.7, label=eng)
     ax2 = a.twinx()
     ax2.plot(df["t"], np.tan(angle), "r-", lw=0.8)
     ax2.set_ylabel("tan β", color="r")
@@ -152,7 +153,7 @@ def figures(out, runs):
     fig, ax = plt.subplots(figsize=(7, 4))
     for (law, timing, eng), (sc, s, df) in runs.items():
         z = df["t"] >= (s["t_first_slip_s"] or 0) - 0.002
-        ax.plot(df["t"][z], speed_down_plate(sc, df)[z] * 1e3, plotstyle.ENGINE_LINES[eng], label=eng)
+        ax.plot(df["t"][z], speed_down_plate(sc, df)[z] * 1e3, **plotstyle.line(eng), label=eng)
         if s.get("t_steady_s"):
             ax.axvline(s["t_steady_s"], color="gray", lw=0.5)
     ax.set_xlabel("t (s)")

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Kind "tray" (paper §3.2, Figs. 10-12): does a grain wedged in a tray stay up?"""
 from __future__ import annotations
 
@@ -119,7 +120,7 @@ def figures(out, runs):
     # Fig. 11: height of grain 1 for the three laws.
     fig, ax = plt.subplots(figsize=(7, 4))
     for (law, timing, eng), (sc, s, df) in runs.items():
-        ax.plot(df["t"], height(sc, df) * 1e3, plotstyle.ENGINE_LINES[eng], label=f"{law} [{eng}]")
+        ax.plot(df["t"], height(sc, df) * 1e3, **plotstyle.line(eng), label=f"{law} [{eng}]")
         r = _grain(sc).radius
     ax.axhline(r * 1e3, color="k", lw=0.5)
     ax.set_xlabel("t (s)")
@@ -137,7 +138,7 @@ def figures(out, runs):
             n = _floor(sc).normal
             sign = 1.0 if a == sc.analysis["grain"] else -1.0  # the force on grain 1
             f = sign * sum(df[f"{a}-{b}_ft{x}"].to_numpy() * n[k] for k, x in enumerate("xyz"[: sc.dimension]))
-            ax.plot(df["t"], f, plotstyle.ENGINE_LINES[eng], lw=0.8, label=eng)
+            ax.plot(df["t"], f, **plotstyle.line(eng), lw=0.8, label=eng)
         ax.set_ylabel("Fs, vertical (N/m)")
         ax.set_title(law, fontsize=9)
         ax.legend(fontsize=8)

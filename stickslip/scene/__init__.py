@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Scene files: one TOML file describes a case once, for every engine.
 
 `load(path_or_name, **overrides)` reads and validates a scene and returns a `Scene`

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """A scene's grains: single grains' spins and masses, and the blocks that make many at once
 (lattice, ring, fill), each checked as it is read; and the starting overlaps every engine
 must agree on (docs/scene-format.md)."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The data a scene file describes: contact parameters, grains, walls, output, time."""
 from __future__ import annotations
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Reading and checking a scene file (docs/scene-format.md).
 
 Every problem raises SceneError with one line that names the key and the allowed
@@ -16,7 +17,7 @@ import numpy as np
 
 from pyref.laws import LAWS, RESETS, SLIP_TIMINGS, LawParams
 
-from .. import columns, kinds
+from .. import columns, kinds, shipped
 from ..errors import SceneError
 from .grains import (MAX_GRAINS, base, base_count, block_count, check_mass, check_periodic, check_start, fill,
                      initial_spin, lattice, lattice_counts,
@@ -25,7 +26,7 @@ from .model import Contact, GravityRamp, Grain, Output, RampPhase, Scene, Wall, 
 from .stability import stability_limits
 from .table import Table, finite, shown, unique
 
-CASES_DIR = Path(__file__).resolve().parents[2] / "cases"
+CASES_DIR = shipped.path("cases")
 EFFECTS = ("gravity", "rotation", "normal_damping", "tangential_damping", "moving_walls")
 # A scene name becomes a folder name (runs/NAME/...): letters, digits, _ . - only.
 NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,99}")

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The largest time step a scene may use, by cause, and the step below which its
 collisions are accurate (docs/scene-format.md)."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """A scene file's TOML tables, read with one-line errors: each value is checked for its type
 and range where it is read, and a key nobody read is an unknown key (docs/scene-format.md)."""
 from __future__ import annotations

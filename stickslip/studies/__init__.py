@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Studies: runs of many scenes that answer one question each, with their figures.
 
 precision.py (error against wall time over a ladder of time steps), thresholds.py (the

@@ -1,24 +1,19 @@
-"""`stickslip calibrate`: mu_s and mu_k for the angles a user measured on their material,
-from the map `stickslip study-3d` measured (docs/granular-3d/points.csv; docs/granular-3d.md).
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""`stickslip calibrate`: mu_s and mu_k for what a user measured on their material, from the map
+`stickslip study-3d` measured (docs/granular-3d/points.csv; docs/granular-3d.md).
 
-The map: at each measured (mu_s, mu_k) of the sweep (stock history on the diagonal, the
-stick-slip pairs below it; LIGGGHTS, the chosen rolling resistance and nu_s variant), the
-mean and standard error over fills of theta_start, theta_stop (incline) and theta_heap
-(heap). Between the points each angle is interpolated linearly on their triangulation (so
-the map reaches exactly the convex hull of the measured points, no further). Given two or
-three target angles, every (mu_s, mu_k) of a fine grid over that hull gets
-chi2 = sum ((angle(mu_s, mu_k) - target) / se(mu_s, mu_k))^2, se interpolated alike; the
-answer is the grid point of least chi2, its uncertainty the extent of the region where
-chi2 <= min + 1 (one standard error, the map's spread over fills). A target outside the
-angles the map reaches, or targets no point of the map gives together within 3 standard
-errors, is refused in one line naming what is reachable (exit status 2).
+The targets: two or more of theta_start, theta_stop (incline), theta_heap (heap) and
+shear_drop (the sheared layer's stick-slip, once the map has it), each a value with its
+standard error (--theta-start-se ...; none: exact), or a CSV of repeated measurements (a
+column per target, one row per repeat, n >= 2: the mean and its standard error std/sqrt(n),
+with n - 1 degrees of freedom). The map: calibrate_map.py (its points and the interpolation
+that leave-one-out chooses, or --interpolation); the answer and its ranges: calibrate_fit.py.
+The region can be drawn on the map (--region-png, calibrate_region.py).
 
-theta_stop is taken at a fixed angle: the study's ramp measures it while the angle falls,
-and the flow's lag puts it below the angle at which a flow held at a fixed angle stops (the
-angle a user's experiment gives). The lag measured on stock history mu = 0.5, 10 d bed, is
-added to every point's theta_stop, its standard error to theirs: from beds held at fixed
-angles (validation.csv beside the map: fixed_lag, granular3d_tables.holds), else from the
-ramp at half its rates (granular3d_tables.ramp_lag, a lag linear in the rate), else none.
+theta_stop is taken at a fixed angle: the study's ramp measures it while the angle falls, and
+the flow's lag puts it below the angle at which a flow held at a fixed angle stops (the angle
+a user's experiment gives). The lag measured on stock history mu = 0.5, 10 d bed, is added to
+the map's theta_stop, its standard error to the map's (calibrate_map.lag_of).
 """
 from __future__ import annotations
 
@@ -28,121 +23,124 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import shipped
 from ..errors import SceneError
-from . import granular3d_tables
+from . import calibrate_fit, calibrate_map
 
-DOCS = Path(__file__).resolve().parents[2] / "docs" / "granular-3d"
-ANGLES = granular3d_tables.ANGLES
-OPTION = {"theta_start": "--theta-start", "theta_stop": "--theta-stop", "theta_heap": "--theta-heap"}
-GRID = 0.0025  # grid step in mu
-JOINT_LIMIT = 9.0  # chi2 above which targets are not reachable together (3 standard errors)
+DOCS = shipped.path("docs/granular-3d")
+TARGETS = calibrate_map.TARGETS
+OPTION = calibrate_fit.OPTION
+UNIT = {"shear_drop": ""}  # the angles are in degrees
 
 
-def load_map(path, rolling, nu_s="paper"):
-    """({angle: (points (n, 2), means, ses)}, (lag, its se, "fixed" | "ramp" | None)): the
-    sweep at this rolling resistance, history (mu_s = mu_k) and the stick-slip pairs with the
-    chosen nu_s in the step mode, theta_stop with the ramp's lag added (the module's docstring)."""
+def read_measurements(path):
+    """{target: Target} from a CSV of repeats: mean, standard error std/sqrt(n), n."""
     path = Path(path)
-    if not path.is_file():
-        raise SceneError(f"--map {path}: not found (stickslip study-3d writes it)")
-    pts = pd.read_csv(path, dtype={"nu_s": str})
-    lag, lag_se = (granular3d_tables.ramp_lag(pts) if {"material", "layers", "rate_factor", "silbert"} <= set(pts)
-                   else (math.nan, math.nan))
-    how = "ramp" if math.isfinite(lag) else None
-    val = path.with_name("validation.csv")
-    if val.is_file():  # the lag to beds held at fixed angles: measured, not extrapolated
-        v = pd.read_csv(val)
-        if "fixed_lag" in v:
-            v = v[(v.engine == "liggghts") & (v.layers == granular3d_tables.SCENE_LAYERS)]
-            if len(v) and math.isfinite(v.fixed_lag.iloc[0]):
-                lag, lag_se, how = float(v.fixed_lag.iloc[0]), float(v.fixed_lag_se.iloc[0]), "fixed"
-    pts = pts[(pts["engine"] == "liggghts") & (pts["group"] == "sweep")]
-    rolls = sorted(pts["rolling"].unique())
-    if not any(math.isclose(rolling, r, abs_tol=1e-9) for r in rolls):
-        raise SceneError(f"--rolling {rolling:g}: the map was measured at rolling resistance "
-                         f"{' and '.join(f'{r:g}' for r in rolls)} only")
-    pts = pts[np.isclose(pts["rolling"], rolling)]
-    pts = pts[(pts.mu_s == pts.mu_k) | ((pts.nu_s == nu_s) & (pts.timing == "step"))]
+    try:
+        df = pd.read_csv(path)
+    except (OSError, ValueError, pd.errors.ParserError) as e:
+        raise SceneError(f"--measurements {path}: cannot be read as CSV ({' '.join(str(e).split())[:120]})") from None
+    unknown = [c for c in df.columns if c not in TARGETS]
+    if unknown or not len(df.columns):
+        raise SceneError(f"--measurements {path}: column {unknown[0] if unknown else '(none)'!r}: the columns must be "
+                         f"among {', '.join(TARGETS)}")
     out = {}
-    for angle in ANGLES:
-        p = pts[(pts.kind == granular3d_tables.KIND[angle]) & np.isfinite(pts[f"{angle}_mean"])]
-        mean, se = p[f"{angle}_mean"].to_numpy(float), p[f"{angle}_se"].fillna(0.0).to_numpy(float)
-        if angle == "theta_stop" and np.isfinite(lag):
-            mean, se = mean + lag, np.hypot(se, lag_se)
-        out[angle] = (p[["mu_s", "mu_k"]].to_numpy(float), mean, se)
-    return out, (lag, lag_se, how)
+    for c in df.columns:
+        v = pd.to_numeric(df[c], errors="coerce")
+        bad = df[c][v.isna() & df[c].notna()]
+        if len(bad):
+            raise SceneError(f"--measurements {path}: {c} = {bad.iloc[0]!r}: not a number")
+        v = v.dropna().to_numpy(float)
+        lo, hi = (0.0, 90.0) if c.startswith("theta") else (0.0, 10.0)
+        if len(v) and not ((v > lo) & (v < hi)).all():
+            raise SceneError(f"--measurements {path}: {c} = {v[~((v > lo) & (v < hi))][0]:g}: must be in "
+                             f"({lo:g}, {hi:g})")
+        if len(v) < 2:
+            raise SceneError(f"--measurements {path}: {c} has {len(v)} value(s): needs n >= 2 repeats for a "
+                             "standard error")
+        out[c] = calibrate_fit.Target(float(v.mean()), float(v.std(ddof=1) / math.sqrt(len(v))), len(v))
+    return out
 
 
-def surfaces(m):
-    """The grid over the measured hull and each angle's (mean, se) on it (NaN outside)."""
-    from scipy.interpolate import LinearNDInterpolator
-
-    xy = np.vstack([v[0] for v in m.values() if len(v[0])])
-    g = np.arange(xy[:, 0].min(), xy[:, 0].max() + GRID / 2, GRID)
-    ms, mk = np.meshgrid(g, np.arange(xy[:, 1].min(), xy[:, 1].max() + GRID / 2, GRID), indexing="ij")
-    grid = np.column_stack([ms.ravel(), mk.ravel()])
-    grid = grid[grid[:, 1] <= grid[:, 0] + 1e-12]
-    out = {}
-    for angle, (p, mean, se) in m.items():
-        if len(p) < 3:
+def targets_of(args):
+    """{target: Target} from the command's options, or SceneError in one line."""
+    out = read_measurements(args.measurements) if getattr(args, "measurements", None) else {}
+    for a in TARGETS:
+        v, se = getattr(args, a, None), getattr(args, f"{a}_se", None)
+        if v is None:
+            if se is not None:
+                raise SceneError(f"{OPTION[a]}-se {se:g}: give {OPTION[a]} too")
             continue
-        out[angle] = (LinearNDInterpolator(p, mean)(grid), LinearNDInterpolator(p, se)(grid))
-    return grid, out
+        if a in out:
+            raise SceneError(f"{OPTION[a]} {v:g}: {a} is also in --measurements {args.measurements}; give it once")
+        out[a] = calibrate_fit.Target(v, se or 0.0)
+    if len(out) < 2:
+        raise SceneError("calibrate: give at least two of --theta-start, --theta-stop, --theta-heap, --shear-drop "
+                         "(or a --measurements file)")
+    return out
 
 
-def solve(targets, m):
-    """(mu_s, mu_k, their one-se ranges, the angles at the answer) for {angle: target}."""
-    grid, surf = surfaces(m)
-    missing = [a for a in targets if a not in surf]
-    if missing:
-        raise SceneError(f"{OPTION[missing[0]]}: the map has no {missing[0]} measurements")
-    inside = np.all([np.isfinite(surf[a][0]) for a in targets], axis=0)
-    for a, v in targets.items():
-        lo, hi = np.nanmin(surf[a][0]), np.nanmax(surf[a][0])
-        if not lo <= v <= hi:
-            raise SceneError(f"{OPTION[a]} {v:g}: outside the measured map, which reaches {a} from {lo:.1f} to "
-                             f"{hi:.1f} deg ({reachable(surf)})")
-    chi2 = np.zeros(len(grid))
-    for a, v in targets.items():
-        mean, se = surf[a]
-        chi2 += ((mean - v) / np.maximum(se, 0.05)) ** 2  # (0.05 deg: a point measured once has no se)
-    chi2[~inside] = np.inf
-    best = int(np.argmin(chi2))
-    if chi2[best] > JOINT_LIMIT:
-        got = ", ".join(f"{a} {surf[a][0][best]:.1f}" for a in targets)
-        raise SceneError(f"{' '.join(f'{OPTION[a]} {v:g}' for a, v in targets.items())}: no (mu_s, mu_k) of the map "
-                         f"gives these together within 3 standard errors (closest: mu_s {grid[best, 0]:.3f}, mu_k "
-                         f"{grid[best, 1]:.3f}: {got} deg); {reachable(surf)}")
-    region = grid[chi2 <= chi2[best] + 1.0]
-    return {"mu_s": grid[best, 0], "mu_k": grid[best, 1], "mu_s_range": (region[:, 0].min(), region[:, 0].max()),
-            "mu_k_range": (region[:, 1].min(), region[:, 1].max()), "chi2": float(chi2[best]),
-            "angles": {a: (float(surf[a][0][best]), float(surf[a][1][best])) for a in surf}}
+def prepare(pts, rolling, method="auto", lag=(math.nan, math.nan, None)):
+    """The surfaces of the map at this rolling resistance, by `method` ("auto": the one of
+    smaller leave-one-out error), the interpolation's own error added, and the leave-one-out
+    rows they came from."""
+    m = calibrate_map.from_points(pts, rolling)
+    rows = calibrate_map.loo(m)
+    chosen = calibrate_map.choose(rows) if method == "auto" else method
+    err = calibrate_map.interp_error(rows)
+    interp = {t: err.get((t, chosen), (0.0, 0))[0] for t in m}
+    return calibrate_fit.surfaces(m, chosen, interp, lag), rows
 
 
-def reachable(surf):
-    parts = [f"{a} {np.nanmin(s[0]):.1f}-{np.nanmax(s[0]):.1f}" for a, s in surf.items()]
-    if "theta_start" in surf and "theta_stop" in surf:
-        d = surf["theta_start"][0] - surf["theta_stop"][0]
-        parts.append(f"theta_start - theta_stop {np.nanmin(d):.1f}-{np.nanmax(d):.1f}")
-    return "reachable: " + ", ".join(parts) + " deg"
+def _range_line(r, name, other):
+    (lo, hi), value = r.ranges[name], getattr(r, name)
+    text = f"{name} = {value:.3f} (one standard error, {other} profiled: {lo:.3f} to {hi:.3f}"
+    for end, bound in (("lo", lo), ("hi", hi)):
+        where = r.cut.get((name, end))
+        if where == "map":
+            text += f"; the range reaches the map's edge at {name} = {bound:.3f}: a bound, not a standard error"
+        elif where:
+            text += f"; the range reaches the law's bound {where} at {name} = {bound:.3f}: a bound, not a standard error"
+    return text + ")"
 
 
 def main(args):
-    targets = {a: getattr(args, a) for a in ANGLES if getattr(args, a) is not None}
-    if len(targets) < 2:
-        raise SceneError("calibrate: give at least two of --theta-start, --theta-stop, --theta-heap (degrees)")
-    m, (lag, lag_se, how) = load_map(args.map or DOCS / "points.csv", args.rolling)
-    r = solve(targets, m)
-    (s0, s1), (k0, k1) = r["mu_s_range"], r["mu_k_range"]
-    print(f"mu_s = {r['mu_s']:.3f} (one standard error: {s0:.3f} to {s1:.3f})")
-    print(f"mu_k = {r['mu_k']:.3f} (one standard error: {k0:.3f} to {k1:.3f})")
-    print(f"2 mu_k - mu_s = {2 * r['mu_k'] - r['mu_s']:.3f} (the force a slipping contact holds, over Fn)")
-    print("the map there: " + ", ".join(f"{a} {v:.1f} +- {e:.1f} deg" for a, (v, e) in r["angles"].items())
-          + f" (chi2 {r['chi2']:.2f}); rolling resistance {args.rolling:g}, the paper's nu_s (0.8 nu_n), step mode;"
-          " the scenes of docs/granular-3d.md")
-    print({"fixed": f"theta_stop at a fixed angle: the ramp's value + {lag:.1f} +- {lag_se:.1f} deg (its lag to beds "
-                    "held at fixed angles, measured)",
-           "ramp": f"theta_stop at zero rate: the ramp's value + {lag:.1f} +- {lag_se:.1f} deg (its lag, from half "
-                   "rates)",
+    targets = targets_of(args)
+    path = args.map or DOCS / "points.csv"
+    pts = calibrate_map.read_points(path)
+    lag = calibrate_map.lag_of(path, pts)
+    surf, rows = prepare(pts, args.rolling, getattr(args, "interpolation", "auto") or "auto", lag)
+    r = calibrate_fit.solve(targets, surf)
+    print(_range_line(r, "mu_s", "mu_k"))
+    print(_range_line(r, "mu_k", "mu_s"))
+    print(f"2 mu_k - mu_s = {2 * r.mu_k - r.mu_s:.3f} (the force a slipping contact holds, over Fn)")
+    print("ranges: chi2 within 1 of its least, the other coefficient profiled (each one's own 68 %); the joint 68 % "
+          "region of (mu_s, mu_k) is chi2 within 2.30 of its least" + (" (drawn in --region-png)" if args.region_png
+                                                                       else " (--region-png draws it)"))
+    print("targets: " + ", ".join(f"{a} {t.value:.2f}" + (f" +- {t.se:.2f}" if t.se else "") + UNIT.get(a, " deg")
+                                  + (f" (mean of {t.n})" if t.n else "" if t.se else " (exact)")
+                                  for a, t in targets.items()))
+    s = calibrate_map.scores(rows)
+    score = "; ".join(f"{m} {v:.2f}" for m, (v, _) in s.items() if np.isfinite(v))
+    n = max((v[1] for v in s.values()), default=0)
+    print("the map there: " + ", ".join(f"{a} {v:.1f} +- {e:.1f}" + UNIT.get(a, " deg") for a, (v, e, _) in
+                                          r.at_best.items())
+          + f" (chi2 {r.chi2:.2f}); interpolation {surf.method}"
+          + (f" (leave-one-out mean (residual/se)^2 on {n} points: {score})" if score else "")
+          + f"; rolling resistance {args.rolling:g}, the paper's nu_s (0.8 nu_n), step mode; the scenes of "
+            "docs/granular-3d.md")
+    print("errors: map, its interpolation's own (leave-one-out: " + ", ".join(
+        f"{t} {e:.2f}" for t, e in surf.interp.items()) + ") and target in quadrature, times Student's t at their "
+          "Welch-Satterthwaite degrees of freedom (" + ", ".join(f"{a} {r.at_best[a][2]:.2f}" for a in targets
+                                                                if a in r.at_best) + " at the answer)")
+    lag_value, lag_se, how = lag
+    print({"fixed": f"theta_stop at a fixed angle: the ramp's value + {lag_value:.1f} +- {lag_se:.1f} deg (its lag to "
+                    "beds held at fixed angles, measured)",
+           "ramp": f"theta_stop at zero rate: the ramp's value + {lag_value:.1f} +- {lag_se:.1f} deg (its lag, from "
+                   "half rates)",
            None: "theta_stop as the ramp measured it (the map has no measure of the ramp's lag)"}[how])
+    if args.region_png:
+        from . import calibrate_region
+
+        print(f"wrote {calibrate_region.draw(r, targets, pts, args.rolling, args.region_png)}")
     return r

@@ -1,9 +1,11 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`stickslip drum-engines`: the turning drum (cases/drum.toml) across engines (issue 24, 5).
 
 Three parts, each written to --out (docs/drum by default) and linked from docs/drum.md:
 - costs: each engine on the drum's first COST_DURATION s (the fill falls and packs into
   ~350 contacts), side by side in one call: grain-steps per second of the engine's own
-  loop, the MPI engines (LIGGGHTS, LAMMPS) on 1 and 2 ranks (costs.csv);
+  loop, the MPI engines (LIGGGHTS, LAMMPS) on 1 and 2 ranks (costs.csv; the runs
+  themselves in --runs, not beside the table: their logs name this machine's folders);
 - divergence: the drum's first DIVERGENCE_DURATION s on pyref and every engine (the MPI
   engines on 1 and 2 ranks), every grain recorded every few steps: how far each engine's grains are from
   pyref's as time goes on (engines_divergence.csv and .png). The engines solve the same
@@ -44,12 +46,13 @@ def _with_two_ranks(engines):
     return [(e, 1) for e in engines] + [(e, 2) for e in engines if e in runner.MPI_ENGINES]
 
 
-def costs(out, engines, progress=False):
-    """Each engine's cost on the drum's first COST_DURATION s; the MPI engines also on 2 ranks."""
+def costs(out, engines, work, progress=False):
+    """Each engine's cost on the drum's first COST_DURATION s; the MPI engines also on 2 ranks
+    (their runs in `work`, the table in `out`)."""
     sc = load("drum", duration=COST_DURATION, every=1000)
     rows = []
     for engine, ranks in _with_two_ranks(engines):
-        summary, _ = runner.run_scene(sc, engine, Path(out) / "costs" / f"{engine}_{ranks}", progress=progress,
+        summary, _ = runner.run_scene(sc, engine, Path(work) / f"{engine}_{ranks}", progress=progress,
                                       ranks=ranks, write_timeseries=False)
         rows.append({"engine": engine, "ranks": ranks, "steps": summary["steps"], "grains": len(sc.grains),
                      "wall_time_s": summary["wall_time_s"],
@@ -180,7 +183,7 @@ def run(out, out_runs, engines, duration, parts, progress=True):
     say = sys.stderr.write
     if "costs" in parts:
         say(f"drum-engines: costs, the drum's first {COST_DURATION} s on {', '.join(engines)} (~1-2 min)\n")
-        print(costs(out, engines, progress).to_string(index=False))
+        print(costs(out, engines, Path(out_runs) / "engines_costs", progress).to_string(index=False))
     if "divergence" in parts:
         say(f"drum-engines: divergence, the drum's first {DIVERGENCE_DURATION} s on {', '.join(engines)} "
             "(pyref and YADE ~1 min each)\n")

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The drum study's figures (stickslip/studies/drum_study.py): the calibration map, the
 distributions of the avalanche angles, and slope traces."""
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`stickslip drum-study`: avalanches in the turning drum, stock history against
 stick-slip (issue 24; the findings: docs/drum.md).
 
@@ -295,7 +296,7 @@ def _table(study, figs):
     return "\n".join(lines)
 
 
-DOCS = Path(__file__).resolve().parents[1] / "docs" / "drum"
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "drum"  # the repository's (a wheel carries no study)
 
 
 def _markdown_table(df):

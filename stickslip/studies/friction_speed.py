@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Mean friction against imposed sliding speed (drag scene), step and exact slip timing.
 
 The paper's Fig. 4/15 message is that friction falls with sliding speed. With the

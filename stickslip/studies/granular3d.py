@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`stickslip study-3d`: what mu_s and mu_k each do to a bed of spheres (issue 39; the
 findings: docs/granular-3d.md).
 
@@ -31,11 +32,24 @@ from ..kinds import heap3d, incline3d
 from ..scene import find, parse
 
 # Stock history: stick_slip with mu_k = mu_s and no tangential dashpot (a slip caps the force
-# at mu Fn: docs/law.md). The range DEM users work in.
-MUS = (0.2, 0.35, 0.5, 0.8)
+# at mu Fn: docs/law.md). The range DEM users work in; 0.65 fills the diagonal of the map.
+MUS = (0.2, 0.35, 0.5, 0.65, 0.8)
 # Stick-slip (mu_s, mu_k): mu_s and 2 mu_k - mu_s vary independently, and both land on MUS
 # (2 mu_k - mu_s = 0.2, 0.5, 0.2, 0.35): each prediction is a measured history point.
 PAIRS = ((0.8, 0.5), (0.8, 0.65), (0.5, 0.35), (0.5, 0.425))
+# The map that calibrate inverts (issue 51): PAIRS and 8 more, 12 pairs over the law's triangle
+# mu_s 0.2-0.8, mu_s / 2 <= mu_k <= mu_s, in rows of mu_s = 0.2, 0.35, 0.5, 0.65, 0.8: every row
+# has a point on the lower edge mu_k = mu_s / 2 (the hull is the whole triangle, so that an
+# answer for a target inside the map is not cut by the map's edge) and one half way up
+# (0.15, 0.26, 0.49) or PAIRS' two; history is the diagonal.
+MAP_PAIRS = PAIRS + ((0.2, 0.1), (0.35, 0.175), (0.5, 0.25), (0.65, 0.325), (0.8, 0.4),
+                     (0.2, 0.15), (0.35, 0.26), (0.65, 0.49))
+# The round trip of calibrate (granular3d_coverage.py): pairs that are not map points, spread
+# over the triangle (two a row of mu_s = 0.27, 0.43, 0.57, 0.73, one low and one high, and the
+# pair of issue 51, (0.65, 0.45)), run on fills the map never used, incline and heap.
+COVERAGE_PAIRS = ((0.27, 0.17), (0.27, 0.24), (0.43, 0.25), (0.43, 0.37), (0.57, 0.35), (0.57, 0.5),
+                  (0.65, 0.45), (0.73, 0.45), (0.73, 0.64))
+COVERAGE_FILLS = (11, 12, 13)
 # The paper's nu_s, as a share of nu_n: Table 2's 33.10 / 41.38 = 0.8. The scenes' nu_n
 # (restitution 0.88) makes it 6.325 m sqrt(g/d).
 NU_S_OVER_NU_N = 33.10 / 41.38
@@ -45,11 +59,6 @@ FILLS = (1, 2, 3)
 # points LAMMPS repeats.
 EXACT_PAIR = (0.8, 0.5)
 LAMMPS_PAIRS = ((0.8, 0.5), (0.5, 0.35))
-# With rolling resistance, the pairs LAMMPS repeats: mu_s 0.8 and 0.5 at the same
-# 2 mu_k - mu_s = 0.2, the largest mu_s - mu_k (0.3, 0.15), so the largest changes for rolling
-# resistance to shrink. The study's size is set by its cost (docs/granular-3d.md, "Cost":
-# what every pair in every variant on both rollings would add).
-ROLLING_PAIRS = ((0.8, 0.5), (0.5, 0.35))
 # A deeper bed for the validation: H = 20 d (Weinhart et al.'s fit: theta_stop ~ 20.2 deg).
 DEEP_LAYERS = 36
 # Silbert et al.'s own contact for the stiffness check: kn = 2e5 m g/d, gamma_n = 50
@@ -112,14 +121,22 @@ def _jobs_of(kind, engine, group, mu_s, mu_k, nu_s, timing, rolling, fills, **mo
     return out
 
 
-def matrix(fills=FILLS, checks=True, engines=("liggghts", "lammps")):
-    """Every run of the study, the sweep first. Sized to the measured cost (docs/granular-3d.md, "Cost")."""
+GROUPS = ("sweep", "validation", "check", "engines", "coverage", "shear")
+
+
+def matrix(fills=FILLS, checks=True, engines=("liggghts", "lammps"), groups=GROUPS):
+    """Every run of the study in `groups`, the sweep first. Sized to the measured cost
+    (docs/granular-3d.md, "Cost")."""
+    return [j for j in _matrix(fills, checks, engines) if j.group in groups]
+
+
+def _matrix(fills, checks, engines):
     jobs = []
     for kind in ("incline", "heap"):
         for rolling in ROLLING:
             for mu in MUS:
                 jobs += _jobs_of(kind, "liggghts", "sweep", mu, mu, "0", "step", rolling, fills)
-            for mu_s, mu_k in (PAIRS if rolling == 0 else ROLLING_PAIRS):
+            for mu_s, mu_k in MAP_PAIRS:
                 jobs += _jobs_of(kind, "liggghts", "sweep", mu_s, mu_k, "paper", "step", rolling, fills)
         # the variants on one pair: without the dashpot the step mode slips at every step above
         # V* (docs/law.md), so nu_s = 0 runs in the exact mode, as the drum's did; and the
@@ -146,6 +163,9 @@ def matrix(fills=FILLS, checks=True, engines=("liggghts", "lammps")):
         jobs += _jobs_of("incline", "lammps", "validation", 0.5, 0.5, "0", "step", 0.0, fills)
         for mu_s, mu_k in LAMMPS_PAIRS:
             jobs += _jobs_of("incline", "lammps", "engines", mu_s, mu_k, "paper", "step", 0.0, fills)
+    for kind in ("incline", "heap"):  # calibrate's round trip: pairs off the map, fills it never used
+        for mu_s, mu_k in COVERAGE_PAIRS:
+            jobs += _jobs_of(kind, "liggghts", "coverage", mu_s, mu_k, "paper", "step", 0.0, COVERAGE_FILLS)
     return jobs
 
 
@@ -277,13 +297,13 @@ def _task(job, sc, data, folder, keep):
 
 
 def run_study(out, out_runs, fills=FILLS, checks=True, engines=("liggghts", "lammps"), only=None, jobs_at_once=2,
-              progress=True, tables_only=False, keep_engine_files=False, jobs=None, scenes=None):
+              progress=True, tables_only=False, keep_engine_files=False, jobs=None, scenes=None, groups=GROUPS):
     """The matrix (or `jobs`): the cost said first, `jobs_at_once` runs side by side, a line
     per finished run, then the tables and figures of every finished run."""
     from . import granular3d_tables
     from .. import parallel
 
-    jobs = jobs if jobs is not None else matrix(fills, checks, engines)
+    jobs = jobs if jobs is not None else matrix(fills, checks, engines, groups)
     if only:
         jobs = [j for j in jobs if any(s in j.label for s in only)]
         if not jobs:
@@ -309,12 +329,14 @@ def run_study(out, out_runs, fills=FILLS, checks=True, engines=("liggghts", "lam
 
 def write_results(out):
     """The tables, figures and summary.md from out/runs.csv alone."""
-    from . import granular3d_figures, granular3d_tables
+    from . import granular3d_calibration, granular3d_figures, granular3d_tables
 
     out = Path(out)
     tables = granular3d_tables.write_tables(out)
+    trust = granular3d_calibration.write(out, tables["points.csv"])
+    tables.update(trust)
     figs = granular3d_figures.draw(out, tables)
-    (out / "summary.md").write_text(granular3d_tables.summary(tables, figs))
+    (out / "summary.md").write_text(granular3d_tables.summary(tables, figs) + granular3d_calibration.markdown(trust))
     print(f"wrote {len(tables) + 1} tables, {len(figs)} figures and summary.md in {out}")
     return tables
 

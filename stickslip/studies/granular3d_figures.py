@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The figures of `stickslip study-3d` (docs/granular-3d.md), from its tables alone
 (granular3d_tables.write_tables passes them): the stock curves with the stick-slip points
 on them, the map (mu_s, mu_k) -> angles, and the validation against Weinhart et al."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The tables, tests of the predictions and summary of `stickslip study-3d`
 (docs/granular-3d.md), all from runs.csv: `write_runs` makes runs.csv from the finished
 runs, `write_tables` the other tables from runs.csv alone, so that the committed CSVs

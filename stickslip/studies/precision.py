@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """What accuracy costs in time: a scene over a ladder of time steps, both slip timings.
 
 Every run's error is measured against a converged answer: the exact-timing run at the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The report's studies: what accuracy costs (precision.py), friction against sliding
 speed (friction_speed.py), and the speed above which every step slips (thresholds.py).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The sliding speed above which every step slips, measured against the formula.
 
 After a slip the spring holds Fmin = (2 mu_k - mu_s)Fn (eq. 8); one step later the

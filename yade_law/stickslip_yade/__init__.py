@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The stick-slip friction law of Khellaf & Mansouri (2024) for YADE, in Python.
 
 Use in an ordinary YADE script (full example: yade_law/example_drag.py, README.md):
@@ -33,6 +34,8 @@ attributes, so the per-contact state lives here, in arrays, and is saved with th
 through O.tags; every attribute read from YADE costs 0.3-0.7 us per contact, about a whole
 step of YADE's native law, so a step reads no per-contact attribute of a sphere pair.
 """
+__version__ = "1.0.0"  # the project's version, pyproject.toml's (tests/test_release.py checks they agree)
+
 from .checks import check_parameters
 from .engines import insert_stickslip, stickslip_engines, stickslip_material
 from .kernel import rotate_history, tangential_force

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The law's state saved with the scene and restored when a scene is loaded.
 
 The state (per contact: the spring D, the slip counter, kn, cn, the last forces; the

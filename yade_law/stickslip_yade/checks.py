@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """What the law accepts: its parameters (ValueError naming the parameter and its range),
 and the engines and shapes of the scene it runs in (refused at the first step, and again
 whenever O.engines or the bodies change, with `RuntimeError: stick-slip law: ...`), and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Contact bookkeeping: the law's state, one row per contact, and how a step finds its
 contacts cheaply.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The energy books in YADE's O.energy (with O.trackEnergy; YADE's keys `kinetic` and
 `gravWork` come from NewtonIntegrator): the tangential law's dissipation split into slips
 and dashpot (docs/law.md, Energy) and its spring energy Ks|D|^2/2, and, because

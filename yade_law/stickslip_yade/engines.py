@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The material and the engine lists: what a YADE script calls (yade_law/README.md)."""
 from . import checks
 from .runner import stickslip_runner

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Per-contact geometry and kinematics (docs/law.md step 1): the normal n from id1 to id2,
 the overlap delta, the lever arms a1, a2 from the bodies' centres to the points whose
 velocities meet, the relative velocity and its normal and tangential parts (eq. 6), and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The bodies as the law reads them from YADE: which ids exist, which are spheres and their
 radii (redone only when bodies are appended or erased), their positions, velocities and
 spins in one C++ call per step, and the periodic cell's motion."""

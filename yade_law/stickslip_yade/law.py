@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """StickSlipLaw: the tangential law for all real interactions, one step per time step.
 
 A step: the bodies' states (kinematics.py), this step's contacts and their geometry

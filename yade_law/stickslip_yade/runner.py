@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The PyRunner that runs the law each step, between YADE's InteractionLoop and
 NewtonIntegrator, and what its command calls.
 

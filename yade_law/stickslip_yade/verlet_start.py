@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """velocity_verlet_start: YADE's first step as the start of velocity Verlet (pyref,
 LIGGGHTS), for a run that must be their twin (yade_law/README.md, "Twin runs")."""
 

@@ -1,0 +1,204 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The inverse problem of `stickslip calibrate`: the (mu_s, mu_k) whose map values best give
+the targets, each with its uncertainty, and ranges whose meaning is stated.
+
+On a grid over the law's triangle (mu_s / 2 <= mu_k <= mu_s) within the map's hull,
+
+    chi2(mu_s, mu_k) = sum over targets (map(mu) - target)^2 / (k^2 (se_map^2 + se_interp^2 + se_target^2))
+
+se_map: the map's prediction there (calibrate_map.predict: its points' fills), se_interp: the
+interpolation's own error (calibrate_map.interp_error, from leave-one-out), se_target: the
+user's (0: taken as exact). k is the coverage factor of the GUM (JCGM 100:2008, annex G):
+Student's t quantile of 84.13 % at the Welch-Satterthwaite degrees of freedom of that sum (a
+standard error from 3 fills is itself uncertain by about half; with known errors k = 1), so
+that +- k se holds 68.27 %.
+
+The answer is the grid point of least chi2. Each coefficient's range is the extent of the
+region chi2 <= min + 1: the other coefficient profiled (minimised over), which is the 68.27 %
+interval of one parameter (Wilks: delta chi2 is chi2 with 1 degree of freedom). The joint
+68.27 % region of the two is chi2 <= min + 2.30 (2 degrees of freedom). Both hold where the
+map is near linear over the region and the errors Gaussian; a region that reaches the map's
+edge or the law's bounds is cut, and its range there is a bound, not a standard error
+(`cut`), which calibrate says.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import SceneError
+from . import calibrate_map
+
+GRID = 0.0025  # grid step in mu
+COVER = 0.6827  # one standard error of a Gaussian
+DELTA_PROFILE = 1.0  # one coefficient, the other profiled: chi2 quantile 0.6827 with 1 dof
+DELTA_JOINT = 2.30  # the pair: chi2 quantile 0.6827 with 2 dof
+JOINT_LIMIT = 9.0  # least chi2 above which the targets are not reachable together (3 standard errors)
+OPTION = {"theta_start": "--theta-start", "theta_stop": "--theta-stop", "theta_heap": "--theta-heap",
+          "shear_drop": "--shear-drop"}
+
+
+@dataclass
+class Target:
+    """A measured value, its standard error (0: exact) and the repeats it is the mean of
+    (None: its error is known, not estimated)."""
+    value: float
+    se: float = 0.0
+    n: int | None = None
+
+
+@dataclass
+class Surfaces:
+    """The grid (mu_s along axis 0, mu_k along axis 1) and each target's prediction on it:
+    {target: (mean, variance, degrees of freedom)}, NaN outside the triangle or the hull."""
+    ms: np.ndarray
+    mk: np.ndarray
+    pred: dict
+    method: str
+    interp: dict = field(default_factory=dict)  # {target: se_interp}
+    lag: tuple = (math.nan, math.nan, None)
+
+    def triangle(self):
+        s, k = np.meshgrid(self.ms, self.mk, indexing="ij")
+        return (k <= s + 1e-9) & (k >= s / 2 - 1e-9)
+
+
+def surfaces(m, method, interp=None, lag=(math.nan, math.nan, None)):
+    """Each target's (mean, variance, dof) on the grid, from map m (calibrate_map.from_points)
+    by `method`; interp {target: se} added to every prediction's variance (infinite dof); the
+    lag (value, se, how) added to theta_stop (common to every point: its whole variance)."""
+    xy = np.vstack([p.xy for p in m.values() if len(p.xy)])
+    ms = np.round(np.arange(xy[:, 0].min(), xy[:, 0].max() + GRID / 2, GRID) / GRID) * GRID
+    mk = np.round(np.arange(xy[:, 1].min(), xy[:, 1].max() + GRID / 2, GRID) / GRID) * GRID
+    s = Surfaces(ms, mk, {}, method, dict(interp or {}), lag)
+    tri = s.triangle()
+    gs, gk = np.meshgrid(ms, mk, indexing="ij")
+    at = np.column_stack([gs[tri], gk[tri]])
+    for target, p in m.items():
+        if len(p.mean) < 3:
+            continue
+        mean, var, nu = calibrate_map.predict(calibrate_map.weights(method, p, at), p)
+        extra = s.interp.get(target, 0.0) ** 2
+        if target == "theta_stop" and math.isfinite(lag[0]):
+            mean, extra = mean + lag[0], extra + lag[1] ** 2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nu = np.where(var > 0, (var + extra) ** 2 / (var ** 2 / nu), np.inf)
+        full = [np.full(tri.shape, np.nan) for _ in range(3)]
+        for f, v in zip(full, (mean, var + extra, nu)):
+            f[tri] = v
+        s.pred[target] = tuple(full)
+    return s
+
+
+_NU = np.geomspace(0.5, 1e5, 600)
+_K = []
+
+
+def coverage_factor(nu):
+    """Student's t quantile of (1 + 0.6827) / 2 at nu degrees of freedom (1 at infinity):
+    interpolated in log nu on a table of scipy's (within 1e-5; a grid's worth at once)."""
+    if not _K:
+        from scipy.stats import t
+
+        _K.append(t.ppf(0.5 + COVER / 2, _NU) / t.ppf(0.5 + COVER / 2, np.inf))
+    nu = np.asarray(nu, float)
+    k = np.interp(np.log(np.where(np.isfinite(nu), np.clip(nu, _NU[0], _NU[-1]), _NU[-1])), np.log(_NU), _K[0])
+    return np.where(np.isfinite(nu) & (nu < _NU[-1]), k, 1.0)
+
+
+@dataclass
+class Result:
+    mu_s: float
+    mu_k: float
+    chi2: float  # least chi2
+    field: np.ndarray  # chi2 on the grid (inf outside)
+    surf: Surfaces
+    ranges: dict  # {"mu_s": (lo, hi), "mu_k": (lo, hi)}
+    cut: dict  # {("mu_s", "lo" | "hi"): "map" | "mu_k = mu_s" | "mu_k = mu_s / 2" (the law's bounds)}
+    at_best: dict  # {target: (mean, se with k, k)}
+
+    def delta_at(self, mu_s, mu_k):
+        """chi2 - least chi2 at the grid point nearest (mu_s, mu_k) (inf off the map)."""
+        i, j = np.abs(self.surf.ms - mu_s).argmin(), np.abs(self.surf.mk - mu_k).argmin()
+        return float(self.field[i, j] - self.chi2)
+
+
+def reachable(surf):
+    parts = [f"{a} {np.nanmin(s[0]):.1f}-{np.nanmax(s[0]):.1f}" for a, s in surf.pred.items()]
+    if "theta_start" in surf.pred and "theta_stop" in surf.pred:
+        d = surf.pred["theta_start"][0] - surf.pred["theta_stop"][0]
+        parts.append(f"theta_start - theta_stop {np.nanmin(d):.1f}-{np.nanmax(d):.1f}")
+    return "reachable: " + ", ".join(parts) + " deg"
+
+
+def _chi2(targets, surf):
+    chi2 = np.zeros(surf.pred[next(iter(targets))][0].shape)
+    for a, t in targets.items():
+        mean, var, nu = surf.pred[a]
+        nu_t = (t.n - 1.0) if t.n else math.inf
+        tot = var + t.se ** 2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nu_all = tot ** 2 / (np.where(np.isfinite(nu), var ** 2 / nu, 0.0) + t.se ** 4 / nu_t)
+        k = coverage_factor(np.where(np.isfinite(nu_all), nu_all, np.inf))
+        chi2 = chi2 + (mean - t.value) ** 2 / (k ** 2 * tot)
+    return np.where(np.isfinite(chi2), chi2, np.inf)
+
+
+def solve(targets, surf):
+    """Result for {target name: Target} on the surfaces, or SceneError in one line: a target the
+    map does not measure, one outside what it reaches (by more than 3 of its standard errors), or
+    targets no point gives together within 3 standard errors."""
+    missing = [a for a in targets if a not in surf.pred]
+    if missing:
+        what = "shear3d measurements (stickslip study-3d --groups shear measures them)" if missing[0] == "shear_drop" \
+            else f"{missing[0]} measurements"
+        raise SceneError(f"{OPTION[missing[0]]}: the map has no {what}")
+    for a, t in targets.items():
+        lo, hi = np.nanmin(surf.pred[a][0]), np.nanmax(surf.pred[a][0])
+        if not lo - 3 * t.se <= t.value <= hi + 3 * t.se:
+            raise SceneError(f"{OPTION[a]} {t.value:g}: outside the measured map, which reaches {a} from {lo:.1f} to "
+                             f"{hi:.1f} deg ({reachable(surf)})")
+    field = _chi2(targets, surf)
+    best = np.unravel_index(np.argmin(field), field.shape)
+    chi2 = float(field[best])
+    ms, mk = float(surf.ms[best[0]]), float(surf.mk[best[1]])
+    if chi2 > JOINT_LIMIT:
+        got = ", ".join(f"{a} {surf.pred[a][0][best]:.1f}" for a in targets)
+        raise SceneError(f"{' '.join(f'{OPTION[a]} {t.value:g}' for a, t in targets.items())}: no (mu_s, mu_k) of "
+                         f"the map gives these together within 3 standard errors (closest: mu_s {ms:.3f}, mu_k "
+                         f"{mk:.3f}: {got} deg); {reachable(surf)}")
+    region = field <= chi2 + DELTA_PROFILE
+    inside = np.isfinite(field)
+    ranges, cut = {}, {}
+    for axis, name, values in ((0, "mu_s", surf.ms), (1, "mu_k", surf.mk)):
+        idx = np.nonzero(region.any(axis=1 - axis))[0]
+        ranges[name] = (float(values[idx.min()]), float(values[idx.max()]))
+        for end, i, step in (("lo", idx.min(), -1), ("hi", idx.max(), 1)):
+            where = _edge(surf, region, inside, axis, i, step)
+            if where:
+                cut[name, end] = where
+    at_best = {}
+    for a, (mean, var, nu) in surf.pred.items():
+        if np.isfinite(mean[best]):
+            k = float(coverage_factor(nu[best]))
+            at_best[a] = (float(mean[best]), k * math.sqrt(var[best]), k)
+    return Result(ms, mk, chi2, field, surf, ranges, cut, at_best)
+
+
+def _edge(surf, region, inside, axis, i, step):
+    """Whether the region's extreme row/column i along `axis` is cut by the domain there: "map"
+    (the map's hull or extent), the law's bound ("mu_k = mu_s", "mu_k = mu_s / 2"), or None
+    (the region closes inside)."""
+    line = region[i] if axis == 0 else region[:, i]
+    n = len(surf.ms) if axis == 0 else len(surf.mk)
+    for j in np.nonzero(line)[0]:
+        s_i, k_i = (i + step, j) if axis == 0 else (j, i + step)
+        if not 0 <= (s_i if axis == 0 else k_i) < n:
+            return "map"
+        if inside[s_i, k_i]:
+            continue
+        s, k = surf.ms[s_i], surf.mk[k_i]
+        return "mu_k = mu_s" if k > s + 1e-9 else "mu_k = mu_s / 2" if k < s / 2 - 1e-9 else "map"
+    return None

@@ -1,0 +1,205 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The measured map that `stickslip calibrate` inverts (docs/granular-3d.md): the study's
+points at one rolling resistance (`from_points`), and each target's surface over (mu_s, mu_k)
+as a linear combination of the points' means, by one of two interpolations:
+
+- linear: barycentric weights on the Delaunay triangulation of the points;
+- quadratic: a + b mu_s + c mu_k + d mu_s^2 + e mu_s mu_k + f mu_k^2 fitted by least squares
+  weighted by 1/se^2 (at least 7 points: one more than its terms); the fit's covariance is
+  its prediction's uncertainty.
+
+Both stop at the points' convex hull: a map is not extrapolated. A prediction is w . y (the
+weights w over the points' means y), so its variance is sum w_i^2 se_i^2 (the points are
+independent: each its own fills) and its degrees of freedom Welch-Satterthwaite's from each
+point's fills - 1 (a point's se from 3 fills is itself uncertain; calibrate's coverage factor
+uses them). For the quadratic sum w_i^2 se_i^2 is the fit's covariance x' C x.
+
+Leave-one-out (`loo`) predicts each point from the others: its residuals measure the
+interpolation's own error, which the fills' spread does not hold (the surface curves between
+the points). `interp_error` is the part of the mean squared residual that the stated
+variances do not explain, added to every prediction's variance; `choose` takes the
+interpolation with the smaller leave-one-out error on the points both can predict.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import SceneError
+from . import granular3d_tables
+
+# What calibrate can take as a target: the column of points.csv ("<target>_mean", "_se",
+# "_n") and the scene kind it is read on. The incline's and the heap's angles; the sheared
+# layer's (kind shear3d) stick-slip drop once the study has measured it on the map's points.
+KIND = dict(granular3d_tables.KIND, shear_drop="shear")
+TARGETS = tuple(KIND)
+METHODS = ("linear", "quadratic")
+SE_FLOOR = 0.05  # deg: a point measured once has no se
+QUADRATIC_TERMS = 6
+
+
+@dataclass
+class Points:
+    """One target's measured points: (mu_s, mu_k), mean, se and fills of each."""
+    xy: np.ndarray
+    mean: np.ndarray
+    se: np.ndarray
+    n: np.ndarray
+
+    def nu(self):
+        """Each point's degrees of freedom: fills - 1 (inf where the fills are not known)."""
+        return np.where(np.isfinite(self.n) & (self.n > 1), self.n - 1.0, np.inf)
+
+
+def read_points(path):
+    path = Path(path)
+    if not path.is_file():
+        raise SceneError(f"--map {path}: not found (stickslip study-3d writes it)")
+    return pd.read_csv(path, dtype={"nu_s": str})
+
+
+def lag_of(path, pts):
+    """(lag, se, "fixed" | "ramp" | None): how far the ramp's theta_stop lies below a bed
+    held at a fixed angle (validation.csv beside the map), else below its zero-rate limit
+    (half rates in the map: granular3d_tables.ramp_lag), else unknown."""
+    lag, lag_se = (granular3d_tables.ramp_lag(pts) if {"material", "layers", "rate_factor", "silbert"} <= set(pts)
+                   else (math.nan, math.nan))
+    how = "ramp" if math.isfinite(lag) else None
+    val = Path(path).with_name("validation.csv") if path is not None else None
+    if val is not None and val.is_file():
+        v = pd.read_csv(val)
+        if "fixed_lag" in v:
+            v = v[(v.engine == "liggghts") & (v.layers == granular3d_tables.SCENE_LAYERS)]
+            if len(v) and math.isfinite(v.fixed_lag.iloc[0]):
+                lag, lag_se, how = float(v.fixed_lag.iloc[0]), float(v.fixed_lag_se.iloc[0]), "fixed"
+    return lag, lag_se, how
+
+
+def from_points(pts, rolling, nu_s="paper"):
+    """{target: Points}: the sweep's points on LIGGGHTS at this rolling resistance, history
+    (mu_s = mu_k) and the stick-slip pairs with the chosen nu_s in the step mode, as the
+    ramp measured them (the lag to a fixed angle, common to every point, is added to the
+    predictions: calibrate_fit.surfaces)."""
+    pts = pts[(pts["engine"] == "liggghts") & (pts["group"] == "sweep")]
+    rolls = sorted(pts["rolling"].unique())
+    if not any(math.isclose(rolling, r, abs_tol=1e-9) for r in rolls):
+        raise SceneError(f"--rolling {rolling:g}: the map was measured at rolling resistance "
+                         f"{' and '.join(f'{r:g}' for r in rolls)} only")
+    pts = pts[np.isclose(pts["rolling"], rolling)]
+    pts = pts[(pts.mu_s == pts.mu_k) | ((pts.nu_s == nu_s) & (pts.timing == "step"))]
+    out = {}
+    for target, kind in KIND.items():
+        if f"{target}_mean" not in pts:
+            continue
+        p = pts[(pts.kind == kind) & np.isfinite(pts[f"{target}_mean"])]
+        mean = p[f"{target}_mean"].to_numpy(float)
+        se = np.maximum(p[f"{target}_se"].fillna(0.0).to_numpy(float), SE_FLOOR)
+        n = p[f"{target}_n"].to_numpy(float) if f"{target}_n" in p else np.full(len(p), np.nan)
+        out[target] = Points(p[["mu_s", "mu_k"]].to_numpy(float), mean, se, n)
+    return out
+
+
+def _design(xy):
+    s, k = xy[:, 0], xy[:, 1]
+    return np.column_stack([np.ones(len(xy)), s, k, s * s, s * k, k * k])
+
+
+def _hull(xy):
+    """The Delaunay triangulation of the points, or None (fewer than 3, or all on a line)."""
+    from scipy.spatial import Delaunay, QhullError
+
+    if len(xy) < 3:
+        return None
+    try:
+        return Delaunay(xy)
+    except QhullError:
+        return None
+
+
+def weights(method, p, at):
+    """(len(at), len(points)) weights w: the prediction at each of `at` is w . mean; rows of
+    NaN outside the points' hull or where the method cannot fit these points."""
+    w = np.full((len(at), len(p.mean)), np.nan)
+    tri = _hull(p.xy)
+    if tri is None:
+        return w
+    simplex = tri.find_simplex(at, tol=1e-9)
+    inside = simplex >= 0
+    if method == "linear":
+        t = tri.transform[simplex[inside]]
+        b = np.einsum("ijk,ik->ij", t[:, :2], at[inside] - t[:, 2])
+        bary = np.column_stack([b, 1.0 - b.sum(axis=1)])
+        rows = np.zeros((inside.sum(), len(p.mean)))
+        np.put_along_axis(rows, tri.simplices[simplex[inside]], bary, axis=1)
+        w[inside] = rows
+        return w
+    a = _design(p.xy)
+    if len(p.mean) <= QUADRATIC_TERMS or np.linalg.matrix_rank(a) < QUADRATIC_TERMS:
+        return w
+    wt = 1.0 / p.se ** 2
+    cov = np.linalg.inv(a.T @ (a * wt[:, None]))
+    w[inside] = _design(at[inside]) @ cov @ (a * wt[:, None]).T
+    return w
+
+
+def predict(w, p):
+    """(mean, variance, degrees of freedom) of the predictions w . mean (NaN where w is)."""
+    c = w ** 2 * p.se ** 2
+    var = c.sum(axis=1)
+    nu_i = p.nu()
+    with np.errstate(invalid="ignore", divide="ignore"):
+        denom = (c ** 2 / nu_i).sum(axis=1)
+        nu = np.where(denom > 0, var ** 2 / denom, np.inf)
+    return w @ p.mean, var, np.where(np.isfinite(var), nu, np.nan)
+
+
+def loo(m, methods=METHODS):
+    """One row per target, method and point: the point predicted from the others, its
+    residual (measured - predicted), the prediction's se and z = residual / sqrt(se_point^2 +
+    se_predicted^2); NaN where the others cannot predict it (outside their hull, too few)."""
+    rows = []
+    for target, p in m.items():
+        for method in methods:
+            for i in range(len(p.mean)):
+                keep = np.arange(len(p.mean)) != i
+                others = Points(p.xy[keep], p.mean[keep], p.se[keep], p.n[keep])
+                mean, var, _ = predict(weights(method, others, p.xy[i:i + 1]), others)
+                r = p.mean[i] - mean[0]
+                rows.append({"target": target, "method": method, "mu_s": p.xy[i, 0], "mu_k": p.xy[i, 1],
+                             "measured": p.mean[i], "se": p.se[i], "predicted": mean[0],
+                             "predicted_se": math.sqrt(var[0]) if np.isfinite(var[0]) else math.nan,
+                             "residual": r, "z": r / math.sqrt(p.se[i] ** 2 + var[0])})
+    return pd.DataFrame(rows, columns=["target", "method", "mu_s", "mu_k", "measured", "se", "predicted",
+                                       "predicted_se", "residual", "z"])
+
+
+def interp_error(rows):
+    """{(target, method): (sd, points)}: the interpolation's own error, the part of the
+    leave-one-out mean squared residual its stated variances do not explain (0 when they do)."""
+    out = {}
+    for (target, method), g in rows.groupby(["target", "method"]):
+        g = g[np.isfinite(g.residual)]
+        excess = float(np.mean(g.residual ** 2 - g.se ** 2 - g.predicted_se ** 2)) if len(g) else 0.0
+        out[target, method] = (math.sqrt(max(excess, 0.0)), len(g))
+    return out
+
+
+def scores(rows):
+    """{method: (score, points)}: mean of (residual / se_point)^2 over the points every method
+    predicts (the same points for each, the same yardstick: the points' own se)."""
+    ok = rows.pivot_table(index=["target", "mu_s", "mu_k"], columns="method", values="residual", aggfunc="first")
+    common = ok.dropna()
+    se = rows.drop_duplicates(["target", "mu_s", "mu_k"]).set_index(["target", "mu_s", "mu_k"]).se
+    return {m: (float(np.mean((common[m] / se.loc[common.index]) ** 2)) if len(common) else math.nan, len(common))
+            for m in ok.columns}
+
+
+def choose(rows):
+    """The interpolation of smaller leave-one-out score (linear where none can be compared)."""
+    s = scores(rows)
+    usable = {m: v for m, v in s.items() if np.isfinite(v[0])}
+    return min(usable, key=lambda m: usable[m][0]) if usable else "linear"

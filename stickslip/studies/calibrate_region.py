@@ -1,0 +1,51 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""`stickslip calibrate --region-png FILE`: the answer's region on the map's (mu_s, mu_k) plane.
+
+The map's domain (the law's triangle within the measured hull) shaded, the measured points,
+the contour chi2 = least + 1 (whose extent along each axis is that coefficient's range) and
+chi2 = least + 2.30 (the joint 68 % region), and the answer. Where the contours meet the
+domain's edge the region is cut: its range there is a bound, which the figure shows.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..plotstyle import pyplot, save
+from . import calibrate_fit
+
+
+def draw(r, targets, pts, rolling, path):
+    """Write the figure to `path` (PNG); returns the path."""
+    plt = pyplot()
+    path = Path(path)
+    fig, ax = plt.subplots(figsize=(6, 5))
+    s, k = np.meshgrid(r.surf.ms, r.surf.mk, indexing="ij")
+    inside = np.isfinite(r.field)
+    ax.contourf(s, k, inside.astype(float), levels=[0.5, 1.5], colors=["0.92"])
+    delta = np.where(inside, r.field - r.chi2, 1e9)
+    cs = ax.contour(s, k, delta, levels=[calibrate_fit.DELTA_PROFILE, calibrate_fit.DELTA_JOINT],
+                    colors=["C0", "C1"], linestyles=["-", "--"])
+    ax.clabel(cs, fmt={calibrate_fit.DELTA_PROFILE: "Δχ² = 1", calibrate_fit.DELTA_JOINT: "Δχ² = 2.30 (68 %)"},
+              fontsize=7)
+    sweep = pts[(pts.engine == "liggghts") & (pts.group == "sweep") & np.isclose(pts["rolling"], rolling)]
+    sweep = sweep.drop_duplicates(["mu_s", "mu_k"])
+    ax.plot(sweep.mu_s, sweep.mu_k, "k.", ms=6, label="measured points")
+    ax.plot(r.mu_s, r.mu_k, "r*", ms=12, label=f"answer ({r.mu_s:.3f}, {r.mu_k:.3f})")
+    for name, (lo, hi) in r.ranges.items():
+        line = ax.axvline if name == "mu_s" else ax.axhline
+        for end, v in (("lo", lo), ("hi", hi)):
+            line(v, color="C0", lw=0.6, ls=":" if (name, end) in r.cut else "-", alpha=0.7)
+    x = np.array([0.15, 0.85])
+    ax.plot(x, x, color="0.5", lw=0.6)
+    ax.plot(x, x / 2, color="0.5", lw=0.6)
+    ax.set_xlabel("μs")
+    ax.set_ylabel("μk")
+    ax.set_title("calibrate: " + ", ".join(f"{a} {t.value:.2f}" + (f" ± {t.se:.2f}" if t.se else "")
+                                           for a, t in targets.items()) + f"; rolling {rolling:g}", fontsize=8)
+    ax.legend(fontsize=7, loc="upper left")
+    fig.text(0.01, 0.01, "ranges (thin lines; dotted: cut by the domain's edge, a bound) from Δχ² = 1; "
+             "grey: the map's domain", fontsize=6)
+    save(fig, path.parent, path.name)
+    return path

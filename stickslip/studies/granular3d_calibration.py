@@ -1,0 +1,155 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""How far `stickslip calibrate` holds, measured on the study's own runs (docs/granular-3d.md,
+"How far the calibration holds"): written by `stickslip study-3d` beside its other tables.
+
+- loo.csv: the map's leave-one-out, each point predicted from the others by each interpolation
+  (calibrate_map.loo), per rolling resistance, and interpolation.csv: each method's score and
+  which one calibrate takes (calibrate_map.choose);
+- coverage.csv: the round trip. Each pair of granular3d.COVERAGE_PAIRS (not map points, run on
+  fills the map never used) gives its mean angles and their standard errors over its fills (n
+  fills: n - 1 degrees of freedom), as a user's measurement; calibrate answers from the map
+  (no leave-out needed: the pairs are not map points) and the row says whether the stated
+  ranges hold the true mu_s, mu_k, and whether the true pair lies in the joint 68 % region.
+  theta_stop is the ramp's on both sides: the lag to a fixed angle, common to both, cancels and
+  is left out. One row per pair and set of targets (TARGET_SETS);
+- coverage_summary.csv: per set of targets, how many ranges held the truth, against 68.27 %
+  and its binomial spread sqrt(p (1 - p) / n), z = (held - n p) / sqrt(n p (1 - p)); a range cut
+  by the map's edge or the law's bound is a bound, not a standard error, and is counted apart.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+from ..errors import SceneError
+from . import calibrate, calibrate_fit, calibrate_map
+
+TARGET_SETS = (("theta_start", "theta_stop"), ("theta_start", "theta_stop", "theta_heap"))
+P = calibrate_fit.COVER
+COLUMNS = ["targets", "mu_s", "mu_k", "fills", "theta_start", "theta_start_se", "theta_stop", "theta_stop_se",
+           "theta_heap", "theta_heap_se", "answer_mu_s", "mu_s_lo", "mu_s_hi", "answer_mu_k", "mu_k_lo", "mu_k_hi",
+           "mu_s_held", "mu_k_held", "mu_s_cut", "mu_k_cut", "delta_chi2_true", "joint_held", "chi2", "interpolation",
+           "refused"]
+
+
+def loo_table(pts):
+    """(loo rows with their rolling resistance, one row per rolling and method: score, points,
+    the interpolation's own error per target and whether calibrate takes it)."""
+    rows, choice = [], []
+    sweep = pts[(pts.engine == "liggghts") & (pts.group == "sweep")]
+    for rolling in sorted(sweep["rolling"].unique()):
+        r = calibrate_map.loo(calibrate_map.from_points(pts, rolling)).assign(rolling=rolling)
+        rows.append(r)
+        chosen, err = calibrate_map.choose(r), calibrate_map.interp_error(r)
+        for method, (score, n) in calibrate_map.scores(r).items():
+            choice.append({"rolling": rolling, "method": method, "score": score, "common_points": n,
+                           "chosen": method == chosen,
+                           **{f"{t}_interp_error": err.get((t, method), (math.nan, 0))[0] for t in r.target.unique()}})
+    return (pd.concat(rows, ignore_index=True) if rows else pd.DataFrame(), pd.DataFrame(choice))
+
+
+def measured(cov):
+    """{(mu_s, mu_k): ({target: Target}, fills)} of the coverage points (incline and heap rows)."""
+    out = {}
+    for (mu_s, mu_k), grp in cov.groupby(["mu_s", "mu_k"]):
+        t = {}
+        for target, kind in calibrate_map.KIND.items():
+            row = grp[grp.kind == kind]
+            if f"{target}_mean" in row and len(row) and np.isfinite(row[f"{target}_mean"].iloc[0]):
+                r = row.iloc[0]
+                n = int(r[f"{target}_n"]) if f"{target}_n" in r and np.isfinite(r[f"{target}_n"]) else None
+                t[target] = calibrate_fit.Target(float(r[f"{target}_mean"]), float(r[f"{target}_se"]), n)
+        out[float(mu_s), float(mu_k)] = (t, int(grp.fills.max()) if "fills" in grp else 0)
+    return out
+
+
+def coverage(pts, method="auto", surf=None):
+    """coverage.csv's rows: the coverage pairs of pts calibrated on its sweep (rolling 0)."""
+    cov = pts[(pts.group == "coverage") & (pts.engine == "liggghts")]
+    if not len(cov):
+        return pd.DataFrame(columns=COLUMNS)
+    surf = surf or calibrate.prepare(pts, 0.0, method)[0]
+    rows = []
+    for (mu_s, mu_k), (got, fills) in measured(cov).items():
+        for names in TARGET_SETS:
+            row = {"targets": "+".join(names), "mu_s": mu_s, "mu_k": mu_k, "fills": fills,
+                   "interpolation": surf.method}
+            for a, t in got.items():
+                row[a], row[f"{a}_se"] = t.value, t.se
+            if not set(names) <= set(got):
+                continue
+            try:
+                r = calibrate_fit.solve({a: got[a] for a in names}, surf)
+            except SceneError as e:
+                rows.append({**row, "refused": str(e)})
+                continue
+            (s0, s1), (k0, k1) = r.ranges["mu_s"], r.ranges["mu_k"]
+            tol = calibrate_fit.GRID / 2
+            delta = r.delta_at(mu_s, mu_k)
+            rows.append({**row, "answer_mu_s": r.mu_s, "mu_s_lo": s0, "mu_s_hi": s1, "answer_mu_k": r.mu_k,
+                         "mu_k_lo": k0, "mu_k_hi": k1, "mu_s_held": s0 - tol <= mu_s <= s1 + tol,
+                         "mu_k_held": k0 - tol <= mu_k <= k1 + tol,
+                         "mu_s_cut": " ".join(f"{e}: {w}" for (n, e), w in r.cut.items() if n == "mu_s"),
+                         "mu_k_cut": " ".join(f"{e}: {w}" for (n, e), w in r.cut.items() if n == "mu_k"),
+                         "delta_chi2_true": delta, "joint_held": delta <= calibrate_fit.DELTA_JOINT, "chi2": r.chi2,
+                         "refused": ""})
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def summary(cov):
+    """Per set of targets and statement (mu_s's range, mu_k's, the joint region): how many held
+    the truth of how many, against P and its binomial spread; uncut ranges apart."""
+    rows = []
+    for targets, g in cov.groupby("targets", sort=False):
+        answered = g[g.refused.fillna("") == ""]
+        for what, held, cut in (("mu_s range", "mu_s_held", "mu_s_cut"), ("mu_k range", "mu_k_held", "mu_k_cut"),
+                                ("joint region", "joint_held", None)):
+            for which, sel in (("all", answered),
+                               ("uncut", answered[answered[cut].fillna("") == ""] if cut else answered)):
+                n = len(sel)
+                k = int(sel[held].astype(bool).sum()) if n else 0
+                sd = math.sqrt(P * (1 - P) / n) if n else math.nan
+                rows.append({"targets": targets, "statement": what, "ranges": which, "pairs": n, "held": k,
+                             "share": k / n if n else math.nan, "expected": P, "binomial_sd": sd,
+                             "z": (k / n - P) / sd if n else math.nan, "refused": len(g) - len(answered)})
+    return pd.DataFrame(rows)
+
+
+def write(out, pts):
+    """loo.csv, interpolation.csv and, when the study ran coverage pairs, coverage.csv and
+    coverage_summary.csv; returns {name: DataFrame}."""
+    tables = {}
+    if ((pts.group == "sweep") & (pts.engine == "liggghts")).any():
+        tables["loo.csv"], tables["interpolation.csv"] = loo_table(pts)
+    if (pts.group == "coverage").any():
+        cov = coverage(pts)
+        tables["coverage.csv"], tables["coverage_summary.csv"] = cov, summary(cov)
+    for name, t in tables.items():
+        t.to_csv(out / name, index=False)
+    return tables
+
+
+def markdown(tables):
+    """summary.md's sections of these tables (none when the study has not made them)."""
+    from .granular3d_tables import _md
+
+    lines = []
+    if "interpolation.csv" in tables:
+        t = tables["interpolation.csv"]
+        lines += ["## The map's interpolation, chosen by leave-one-out", "",
+                  "Each map point predicted from the others ([loo.csv](loo.csv)); score: mean (residual / se)² over the "
+                  "points both interpolations predict; the interpolation's own error: the residuals' part that the "
+                  "stated errors do not explain, which calibrate adds.", "",
+                  _md(t, list(t.columns), ".3g")]
+    if "coverage_summary.csv" in tables:
+        lines += ["## Calibrate's round trip: how often its ranges hold the truth", "",
+                  f"Pairs off the map, on fills it never used ([coverage.csv](coverage.csv)); expected {P:.1%} ± the "
+                  "binomial spread.", "",
+                  _md(tables["coverage_summary.csv"], ["targets", "statement", "ranges", "pairs", "held", "share",
+                                                       "expected", "binomial_sd", "z", "refused"]),
+                  _md(tables["coverage.csv"], ["targets", "mu_s", "mu_k", "answer_mu_s", "mu_s_lo", "mu_s_hi",
+                                               "answer_mu_k", "mu_k_lo", "mu_k_hi", "mu_s_held", "mu_k_held",
+                                               "delta_chi2_true", "joint_held", "mu_s_cut", "mu_k_cut"], ".3f")]
+    return "\n".join(lines)
