@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
-# The two commands of the README, on a fresh Debian 12 machine:
+# The README's commands, on a fresh Debian 12 machine:
 #   ./run.sh report   set up, then run every paper case on every engine -> report/report.md
 #   ./run.sh test     set up, then run the test suite
 #   ./run.sh wheel-check  set up, then build the wheel and run it installed outside the repository
@@ -9,8 +9,10 @@
 # plugin (with the LAMMPS headers it needs, taken from Debian's source package).
 # STICKSLIP_SOURCE_BUILDS (a comma-separated list; .ci/run sets it) also builds engines from
 # Debian's source packages, once, cached in build/ (a second set-up costs seconds):
-#   lammps-2025   LAMMPS 4 Feb 2025 (Debian 13's source) with the tangential sub-model
-#                 stick_slip compiled in: build/lammps_2025/build/lmp (~3 min on 2 cores)
+#   lammps-2025      LAMMPS 4 Feb 2025 (Debian 13's source) with the tangential sub-model
+#                    stick_slip compiled in: build/lammps_2025/build/lmp (~3 min on 2 cores)
+#   liggghts-public  LIGGGHTS-PUBLIC 3.8.0 (Debian 12's source) with tangential stick_slip
+#                    built in by `make auto`: build/liggghts_public/source/src/lmp_auto (~7 min)
 set -euo pipefail
 cd "$(dirname "$0")"
 

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The paper's drag (Khellaf & Mansouri 2024, section 3.1, Table 2) on DEM-Engine with the
 stick-slip force model: the 2D disk (r = 2 mm, 2600 kg/m3) as an equivalent sphere of its
 mass per metre, held in the xy-plane without rolling, pushed along a fixed floor at

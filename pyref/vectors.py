@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Row-wise vector arithmetic of pyref's solver on (K, 3) arrays: cross products, scatter-adds
 into per-grain rows, finiteness and rotations about a fixed axis, each written for the few
 rows a step of a small scene has, where numpy's general forms cost more than the arithmetic."""

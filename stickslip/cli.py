@@ -58,8 +58,12 @@ def _nonnegative(text):
     return _number(text, float, lambda v: 0 <= v < 90, "a standard error in [0, 90)")
 
 
-def _share(text):
-    return _number(text, float, lambda v: 0 < v < 1, "in (0, 1)")
+def _ratio(text):
+    return _number(text, float, lambda v: 0 < v < 5, "a stress ratio in (0, 5)")
+
+
+def _dilation(text):
+    return _number(text, float, lambda v: -5 < v < 5, "in grain diameters, in (-5, 5)")
 
 
 def _folder(text):
@@ -164,6 +168,8 @@ def build_parser():
                     help="LAMMPS repeats the validation and two stick-slip points (default: both)")
     g3.add_argument("--jobs", type=_count, default=2, help="runs side by side (default: 2)")
     g3.add_argument("--tables-only", action="store_true", help="tables and figures of the runs on disk; run nothing")
+    g3.add_argument("--cost-only", action="store_true", help="say what the study would run and its CPU hours, per "
+                                                             "group; run nothing, write nothing")
     g3.add_argument("--from-csv", action="store_true",
                     help="redraw the tables, figures and summary from OUT/runs.csv alone (the committed results)")
     g3.add_argument("--smoke", action="store_true", help="a study of a few seconds on small scenes (the test suite's)")
@@ -175,12 +181,17 @@ def build_parser():
     cal.add_argument("--theta-start", type=_angle, help="angle at which a bed starts to flow, deg")
     cal.add_argument("--theta-stop", type=_angle, help="angle at which a flowing bed stops, deg")
     cal.add_argument("--theta-heap", type=_angle, help="angle of repose of a heap on a plate, deg")
-    cal.add_argument("--shear-drop", type=_share, help="mean stress drop of a sheared layer's slips over the normal "
-                                                       "stress (kind shear3d; needs a map that measured it)")
-    for name in ("theta-start", "theta-stop", "theta-heap", "shear-drop"):
+    cal.add_argument("--shear-peak", type=_ratio, help="peak shear over normal stress of a shear cell (kind shear3d; "
+                                                       "needs a map that measured it)")
+    cal.add_argument("--shear-steady", type=_ratio, help="steady shear over normal stress of a shear cell (kind "
+                                                         "shear3d; needs a map that measured it)")
+    cal.add_argument("--shear-dilation", type=_dilation, help="rise of a shear cell's lid under shear, in grain "
+                                                             "diameters (kind shear3d; needs a map that measured it)")
+    for name in ("theta-start", "theta-stop", "theta-heap", "shear-peak", "shear-steady", "shear-dilation"):
         cal.add_argument(f"--{name}-se", type=_nonnegative, help=f"standard error of --{name} (default 0: exact)")
     cal.add_argument("--measurements", type=Path, help="CSV of repeated measurements: a column per target "
-                                                       "(theta_start, theta_stop, theta_heap, shear_drop), a row per "
+                                                       "(theta_start, theta_stop, theta_heap, shear_peak, "
+                                                       "shear_steady, shear_dilation), a row per "
                                                        "repeat, n >= 2; mean and standard error from them")
     cal.add_argument("--interpolation", choices=("auto", "linear", "quadratic"), default="auto",
                      help="the map's interpolation (default auto: the one of smaller leave-one-out error)")
@@ -322,7 +333,8 @@ def cmd_study_3d(args):
     granular3d.run_study(args.out, args.runs, fills=tuple(range(1, args.fills + 1)), checks=not args.no_checks,
                          engines=tuple(args.engines), only=args.only, jobs_at_once=args.jobs,
                          progress=not args.quiet, tables_only=args.tables_only,
-                         keep_engine_files=args.keep_engine_files, groups=tuple(args.groups), **smoke)
+                         keep_engine_files=args.keep_engine_files, groups=tuple(args.groups), cost_only=args.cost_only,
+                         **smoke)
     return 0
 
 

@@ -22,6 +22,9 @@ BULK = ("com_x", "com_y", "com_z", "vcm_x", "vcm_y", "vcm_z")
 # With a gravity_ramp: the angle gravity has turned by over the interval that ends at the
 # row (rad) and the index of that interval's phase.
 RAMP = ("tilt", "phase")
+# With a [lid]: its displacement along x since the start (m), its centre's height (m), its
+# velocity along x (m/s) and the spring's pull on it along x (N).
+LID = ("lid_x", "lid_z", "lid_vx", "lid_force")
 
 
 def grain(name, dim, rotation):
@@ -57,6 +60,8 @@ def names(scene):
         cols += ENERGY
     if out.bulk:
         cols += BULK
+    if getattr(scene, "lid", None) is not None:
+        cols += LID
     if scene.gravity_ramp is not None:
         cols += RAMP
     return cols

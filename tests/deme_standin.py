@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """A stand-in for DEM-Engine's `deme` module that records every call, for the code that drives
 the engine (the adapter, deme_model/'s helper and example) on a machine without a GPU."""
 import numpy as np

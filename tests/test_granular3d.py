@@ -203,11 +203,14 @@ def test_study_smoke_states_its_cost_keeps_its_runs_and_resumes(tmp_path, capsys
     args = ["study-3d", "--smoke", "--runs", str(tmp_path / "runs"), "--out", str(tmp_path / "out"), "--quiet"]
     assert main(args) == 0
     err = capsys.readouterr().err
-    assert "stickslip study-3d: 3 runs, 0 already on disk" in err and "3 to run (2 at once), about" in err
+    assert "stickslip study-3d: 4 runs, 0 already on disk" in err and "4 to run (2 at once), about" in err
     runs = pd.read_csv(tmp_path / "out" / "runs.csv")
-    assert len(runs) == 3 and np.isfinite(runs.loc[runs.kind == "incline", "theta_stop"]).all()
+    assert len(runs) == 4 and np.isfinite(runs.loc[runs.kind == "incline", "theta_stop"]).all()
     assert np.isfinite(runs.loc[runs.kind == "heap", "theta_heap"]).all()
-    for name in ("points.csv", "predictions.csv", "summary.md", "granular3d_curves.png", "granular3d_map.png"):
+    assert np.isfinite(runs.loc[runs.kind == "shear", ["shear_peak", "shear_steady"]]).all().all()
+    assert (tmp_path / "runs" / runs.label[runs.kind == "shear"].iloc[0] / "series.csv").is_file()
+    for name in ("points.csv", "predictions.csv", "summary.md", "granular3d_curves.png", "granular3d_map.png",
+                 "loo.csv", "sensitivity.csv"):
         assert (tmp_path / "out" / name).is_file()
     assert main(args) == 0  # everything is on disk: nothing runs again
     assert "to run" not in capsys.readouterr().err
@@ -369,7 +372,8 @@ def test_the_committed_figures_and_tables_come_from_the_committed_runs(tmp_path)
 
     shutil.copy(DOCS / "runs.csv", tmp_path / "runs.csv")
     assert main(["study-3d", "--from-csv", "--out", str(tmp_path)]) == 0
-    for name in ("points.csv", "predictions.csv", "validation.csv", "engines.csv", "hysteresis.csv"):
+    for name in ("points.csv", "predictions.csv", "validation.csv", "engines.csv", "hysteresis.csv", "loo.csv",
+                 "interpolation.csv"):
         got, committed = pd.read_csv(tmp_path / name), pd.read_csv(DOCS / name)
         pd.testing.assert_frame_equal(got, committed, check_exact=False, rtol=1e-9)
     for png in DOCS.glob("*.png"):
@@ -508,14 +512,16 @@ def test_holds_take_the_step_between_the_highest_stop_and_the_lowest_flow():
     assert se == pytest.approx(math.hypot(np.std([21.75, 21.25], ddof=1) / math.sqrt(2), 0.5 / math.sqrt(12)))
 
 
-def test_the_pages_calibrate_examples_print_what_the_page_shows(capsys):
+def test_the_pages_calibrate_examples_print_what_the_page_shows(capsys, monkeypatch):
     """Every `stickslip calibrate` console example of docs/granular-3d.md, run on the committed
-    map: its output (stdout, or the one error line) is the page's, line for line."""
+    map from the repository's root (a measurements file's path is relative to it): its output
+    (stdout, or the one error line) is the page's, line for line."""
     import re
 
+    monkeypatch.chdir(DOCS.parent.parent)
     page = (DOCS.parent / "granular-3d.md").read_text()
     blocks = re.findall(r"```console\n\$ \.venv/bin/stickslip (calibrate [^\n]*)\n(.*?)```", page, re.S)
-    assert len(blocks) >= 2
+    assert len(blocks) >= 3 and any("--measurements" in c for c, _ in blocks)
     for command, shown in blocks:
         code = main(command.split())
         got = capsys.readouterr()

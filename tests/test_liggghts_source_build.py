@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """`tangential stick_slip` built into LIGGGHTS-PUBLIC 3.8 the LIGGGHTS way (the law's header
 copied into src/, then `make auto`: liggghts_plugin/doc/tangential_model_stick_slip.md,
 "Build into LIGGGHTS"; `STICKSLIP_SOURCE_BUILDS=liggghts-public ./run.sh setup` builds it
@@ -154,3 +155,20 @@ def test_keyword_settings_in_tree_are_spelled_on_off(tmp_path):
     assert (tmp_path / "in_tree" / "dump.all").read_bytes() != (tmp_path / "default" / "dump.all").read_bytes()
     code, out = run(LMP_AUTO, tmp_path / "keyword", plugin, steps, check=False)
     assert code != 0 and "Unknown argument or wrong keyword order: 'history_rotation'" in out
+
+
+def test_combination_outside_the_whitelist_runs_generic_with_the_plugins_answers(tmp_path):
+    """hooke/stiffness with cohesion sjkr2 and rolling friction cdt is compiled in neither
+    build: both run it through their copy of LIGGGHTS' generic contact model (and say so)."""
+    script = edit(pour_script(), "tangential stick_slip absolute_damping",
+                  "tangential stick_slip cohesion sjkr2 rolling_friction cdt absolute_damping")
+    script = edit(script, '"model hooke/stiffness tangential stick_slip"',
+                  '"model hooke/stiffness tangential stick_slip cohesion sjkr2 rolling_friction cdt"')
+    script = edit(script, "coefficientKineticFriction peratomtypepair 1 0.45\n",
+                  "coefficientKineticFriction peratomtypepair 1 0.45\n"
+                  "fix             m7 all property/global coefficientRollingFriction peratomtypepair 1 0.05\n"
+                  "fix             m8 all property/global cohesionEnergyDensity peratomtypepair 1 50\n")
+    steps = ("-var", "steps", str(POUR_STEPS))
+    outs = run_both(tmp_path, [("plugin", LAUNCHER, script, steps), ("in_tree", LMP_AUTO, script, steps)])
+    assert all("not located in any whitelist" in out for out in outs.values())
+    assert_same(tmp_path, "plugin", "in_tree", outs, ["dump.all", "dump.contacts", "dump.grains"])

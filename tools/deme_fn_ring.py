@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """How far a one-grain case's normal force strays while the grain sticks before its first
 slip: Fn over the weight's normal share, read from a run's time series (pyref's, the GPU's
 or the emulated engine's). The GPU check bounds its figures with it (tools/deme_gpu_check.py),

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The GPU check's bench part (tools/deme_gpu_check.py): a bed of >= 500 000 spheres settling
 in a box, the stick-slip model (Hertz-Mindlin normal force) against the engine's own
 frictional Hertz-Mindlin, same bed, same steps, alternated in one process; the ratio per

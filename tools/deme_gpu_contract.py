@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The GPU check's contract part (tools/deme_gpu_check.py): every row of tests/law_contract.py
 on DEM-Engine side by side in one solver (the force model's sweep: each row's coefficients,
 timing and reset per owner; positions, velocities and spins prescribed per family as the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """How the GPU check's parts, parallel processes (tools/deme_gpu_check.py), wait for each
 other: a part writes its JSON under the work folder, and the check marks a part that ended
 with PART.done."""

@@ -321,7 +321,12 @@ LAMMPS_GRANULAR_MUTANTS = (
            "// eq. 5: the trial force, spring + dashpot scale3(-ks, history, gm->fs); scale3(damp, gm->vtr, temp); "
            "add3(gm->fs, temp, gm->fs);"),
     Mutant("exact_start_sign", "sign error in the trial force at the step's start (exact timing)",
-           "sub3(start, temp, start);", "add3(start, temp, start);"),
+           "const double start[3] = {gm->fs[0] + ksdt * gm->vtr[0], gm->fs[1] + ksdt * gm->vtr[1],",
+           "const double start[3] = {gm->fs[0] - ksdt * gm->vtr[0], gm->fs[1] - ksdt * gm->vtr[1],"),
+    Mutant("exact_e4_shortcut_sign", "sign error in the spring reset",
+           "history[i] = aks * gm->vtr[i];", "history[i] = -aks * gm->vtr[i];"),
+    Mutant("threshold_gt_exact_e4", "> for >= at the threshold",
+           "if (!TOTAL && start2 >= Fscrit * Fscrit && Fscrit > 0.0", "if (!TOTAL && start2 > Fscrit * Fscrit && Fscrit > 0.0"),
     Mutant("turn_loses_length", "a turned history that loses its length",
            "scale3(prjmag > 0 ? shrmag / prjmag : 0, history);", ""),
     Mutant("exact_misses_whole_cycles", "exact timing that misses a slip inside the step",

@@ -38,10 +38,8 @@ static constexpr double EPSILON = 1e-10;
 
 /* ---------------------------------------------------------------------- */
 
-GranSubModTangentialStickSlip::GranSubModTangentialStickSlip(GranularModel *gm, LAMMPS *lmp, bool total,
-                                                             bool exact, bool record) :
-    GranSubModTangential(gm, lmp), reset_total(total), exact(exact), record(record), xt(0.0), kin(0.0), ratio(1.0),
-    mindlin(false)
+GranSubModTangentialStickSlip::GranSubModTangentialStickSlip(GranularModel *gm, LAMMPS *lmp, bool record) :
+    GranSubModTangential(gm, lmp), xt(0.0), kin(0.0), ratio(1.0), mindlin(false)
 {
   num_coeffs = 4;
   size_history = record ? SIZE_RECORD : SIZE_PLAIN;
@@ -135,103 +133,125 @@ void GranSubModTangentialStickSlip::report_record(const double *history)
 
 template <bool TOTAL, bool EXACT, bool RECORD> void GranSubModTangentialStickSlip::step()
 {
-  double temp[3];
+  // (the contact's vectors in locals: stores through `history` could alias the model's
+  // arrays, and the compiler would load them again after each)
   damp = xt * gm->damping_model->get_damp_prefactor();    // nu_s
   const double fncrit = gm->normal_model->get_fncrit();      // |Fn| (adhesive models: their own)
   const double Fscrit = fncrit * mu;                         // T = mu_s |Fn|
   const double ks = mindlin ? k * gm->contact_radius : k;
   double *history = &gm->history[history_index];
-  const double before2 = RECORD ? lensq3(history) : 0.0;
+  const double v[3] = {gm->vtr[0], gm->vtr[1], gm->vtr[2]};    // V_s (eq. 6)
+  double D[3] = {history[0], history[1], history[2]};
+  const double before2 = RECORD ? lensq3(D) : 0.0;
+  double *fs = gm->fs;
 
-  double turned[3];    // D before the step's increment (the exact timing's start)
   const bool update = gm->history_update;    // false: a set-up evaluation, no time passes
   if (update) {
     // step 3: turn D into the current tangent plane keeping its length (linear_history's
     // arithmetic)
-    const double rsht = dot3(history, gm->nx);
+    const double *nx = gm->nx;
+    const double rsht = dot3(D, nx);
     if (fabs(rsht) * ks > EPSILON * Fscrit) {
-      const double shrmag = len3(history);
-      scale3(rsht, gm->nx, temp);
-      sub3(history, temp, history);
-      const double prjmag = len3(history);
-      scale3(prjmag > 0 ? shrmag / prjmag : 0, history);
+      const double shrmag = len3(D);
+      for (int i = 0; i < 3; i++) D[i] = D[i] - rsht * nx[i];
+      const double prjmag = len3(D);
+      scale3(prjmag > 0 ? shrmag / prjmag : 0, D);
     }
-    if (EXACT) copy3(history, turned);
     // eq. 7: D += V_s dt
-    scale3(gm->dt, gm->vtr, temp);
-    add3(history, temp, history);
-  } else {
-    if (gm->contact_type == PAIR && gm->calculate_svector) {
-      // pair granular's single() (compute pair/local): report, change nothing
-      if (RECORD) {
-        copy3(&history[HIST_FS], gm->fs);
-        report_record(history);
-      } else {
-        // the force the law would apply now, with no time passing
-        scale3(-ks, history, gm->fs);
-        scale3(damp, gm->vtr, temp);
-        sub3(gm->fs, temp, gm->fs);
-        const double magfs = len3(gm->fs);
-        if (magfs >= Fscrit) scale3(magfs > 0.0 && lensq3(history) != 0.0 ? fncrit * kin / magfs : 0.0, gm->fs);
-      }
-      return;
+    const double dt = gm->dt;
+    for (int i = 0; i < 3; i++) D[i] = D[i] + dt * v[i];
+  } else if (gm->contact_type == PAIR && gm->calculate_svector) {
+    // pair granular's single() (compute pair/local): report, change nothing
+    if (RECORD) {
+      copy3(&history[HIST_FS], fs);
+      report_record(history);
+    } else {
+      // the force the law would apply now, with no time passing
+      for (int i = 0; i < 3; i++) fs[i] = -ks * D[i] - damp * v[i];
+      const double magfs = len3(fs);
+      if (magfs >= Fscrit) scale3(magfs > 0.0 && lensq3(D) != 0.0 ? fncrit * kin / magfs : 0.0, fs);
     }
-    if (EXACT) copy3(history, turned);
+    return;
   }
 
   // eq. 5: the trial force, spring + dashpot
-  scale3(-ks, history, gm->fs);
-  scale3(damp, gm->vtr, temp);
-  sub3(gm->fs, temp, gm->fs);
+  double F[3], dv[3];
+  for (int i = 0; i < 3; i++) {
+    dv[i] = damp * v[i];
+    F[i] = -ks * D[i] - dv[i];
+  }
 
   // step 5: slip if |F_t| >= mu_s |Fn|
-  const double magfs = len3(gm->fs);
+  const double magfs = len3(F);
   bool slipped = magfs >= Fscrit;
   if (EXACT) {
     // E0: |F| moves on a line in the step and is convex, so the step has no slip iff the
     // trial force is below T at both ends; then the result is the step timing's. The
-    // trial force at the start holds the spring before its increment.
-    double start[3];
-    scale3(-ks, turned, start);
-    sub3(start, temp, start);
-    slipped = slipped || lensq3(start) >= Fscrit * Fscrit;
+    // trial force at the start holds the spring before its increment: F + Ks dt V_s (a set-up
+    // evaluation is a step of length 0).
+    const double ksdt = update ? ks * gm->dt : 0.0;
+    const double start[3] = {F[0] + ksdt * v[0], F[1] + ksdt * v[1], F[2] + ksdt * v[2]};
+    const double start2 = lensq3(start);
+    slipped = slipped || start2 >= Fscrit * Fscrit;
     if (slipped) {
-      // E1-E7 (exact_slip_timing.h); E6 when nothing is added at a reset
       const double fmin = fncrit * kin;    // Fmin (eq. 8)
-      const bool flow_law = ratio == 1.0 && (TOTAL || damp == 0.0);
-      double applied[3], trial[3], stick;
-      stickslip::exact_slips(start, gm->vtr, Fscrit, fmin, ratio, ks, damp, update ? gm->dt : 0.0, TOTAL, flow_law,
-                             applied, trial, stick);
-      copy3(applied, gm->fs);
-      // the spring holds the trial force at the end less the dashpot (eq. 5)
-      for (int i = 0; i < 3; i++) history[i] = -(trial[i] + temp[i]) / ks;
+      const double vs2 = lensq3(v), damp2 = damp * damp;
+      if (!TOTAL && start2 >= Fscrit * Fscrit && Fscrit > 0.0 && damp2 * vs2 > 0.0 &&
+          (fmin * fmin + damp2 * vs2 - Fscrit * Fscrit) * sqrt(start2) - 2.0 * fmin * damp * dot3(start, v) >= 0.0) {
+        // E4 at the step's start, the common slipping case of a flowing bed: the force is at
+        // or above T at theta = 0, and after the slip the dashpot alone keeps it there,
+        // |Fmin t0 + nu_s |V_s| u| >= T (t0 = F0/|F0|, u = -V_s/|V_s|; expanded: one square
+        // root, no division). It slides at Fmin u all step; the spring holds the trial force
+        // (Fmin + nu_s |V_s|) u less the dashpot (eq. 5). exact_slips' closed form, inline.
+        const double a = fmin / sqrt(vs2), aks = a / ks;
+        for (int i = 0; i < 3; i++) {
+          F[i] = -a * v[i];
+          D[i] = aks * v[i];
+        }
+      } else {
+        // E1-E7 (exact_slip_timing.h); E6 when nothing is added at a reset
+        const bool flow_law = ratio == 1.0 && (TOTAL || damp == 0.0);
+        double applied[3], trial[3], stick;
+        stickslip::exact_slips(start, v, Fscrit, fmin, ratio, ks, damp, update ? gm->dt : 0.0, TOTAL, flow_law, applied,
+                               trial, stick);
+        // the spring holds the trial force at the end less the dashpot (eq. 5)
+        for (int i = 0; i < 3; i++) {
+          F[i] = applied[i];
+          D[i] = -(trial[i] + dv[i]) / ks;
+        }
+      }
     }
   } else if (slipped) {
-    if (len3(history) != 0.0) {
+    if (len3(D) != 0.0) {
       // the force drops to Fmin along the trial force; eq. 8 resets the spring to hold
       // Fmin alone, or with /total spring + dashpot (linear_history's rescale)
       const double fmin = fncrit * kin;    // Fmin (eq. 8)
       const double scale = magfs > 0.0 ? fmin * (1.0 / magfs) : 0.0;
-      scale3(scale, gm->fs, history);
-      if (TOTAL) add3(history, temp, history);
-      scale3(-1.0 / ks, history);
-      scale3(scale, gm->fs);
+      const double back = -1.0 / ks;
+      for (int i = 0; i < 3; i++) {
+        D[i] = scale * F[i];
+        if (TOTAL) D[i] = D[i] + dv[i];
+        D[i] = back * D[i];
+        F[i] = scale * F[i];
+      }
     } else {
       // linear_history's rule: a zero spring (a new contact in a set-up evaluation) gets no
       // tangential force when the dashpot alone reaches the threshold
-      zero3(gm->fs);
+      F[0] = F[1] = F[2] = 0.0;
     }
   }
 
+  copy3(D, history);
+  copy3(F, fs);
   if (RECORD) {
     if (update) {
       // docs/law.md "Energy": the work the contact received, -F_s.V_s dt, less the increase
       // of the spring energy Ks |D|^2/2
-      history[HIST_WORK] += -dot3(gm->fs, gm->vtr) * gm->dt - 0.5 * ks * (lensq3(history) - before2);
+      history[HIST_WORK] += -dot3(F, v) * gm->dt - 0.5 * ks * (lensq3(D) - before2);
       if (slipped) history[HIST_NSLIP] += 1.0;
     }
     history[HIST_FN] = gm->Fntot;
-    copy3(gm->fs, &history[HIST_FS]);
+    copy3(F, &history[HIST_FS]);
     if (gm->calculate_svector) report_record(history);    // (walls with per-atom output)
   }
 }

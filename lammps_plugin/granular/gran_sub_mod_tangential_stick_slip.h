@@ -38,7 +38,8 @@ namespace Granular_NS {
      as a multiple of the damping model's prefactor, as linear_history's), mu_s, mu_k. */
   class GranSubModTangentialStickSlip : public GranSubModTangential {
    public:
-    GranSubModTangentialStickSlip(class GranularModel *, class LAMMPS *, bool total, bool exact, bool record);
+    // record: the history keeps the record too (/record); the other options are step()'s
+    GranSubModTangentialStickSlip(class GranularModel *, class LAMMPS *, bool record);
     void coeffs_to_local() override;
     void mix_coeffs(double *, double *) override;
 
@@ -49,7 +50,6 @@ namespace Granular_NS {
     enum { NRECORD = 6 };
 
    protected:
-    const bool reset_total, exact, record;    // the name's suffixes
     double xt;                                // tangential damping, a multiple of the damping prefactor
     double kin;                               // 2 mu_k - mu_s: Fmin = kin Fn (eq. 8; exactly mu_s when mu_k = mu_s)
     double ratio;                             // Fmin/T = kin/mu_s (exact timing)
@@ -65,7 +65,7 @@ namespace Granular_NS {
   class GranSubModTangentialStickSlipWith : public GranSubModTangentialStickSlip {
    public:
     GranSubModTangentialStickSlipWith(class GranularModel *gm, class LAMMPS *lmp) :
-        GranSubModTangentialStickSlip(gm, lmp, TOTAL, EXACT, RECORD)
+        GranSubModTangentialStickSlip(gm, lmp, RECORD)
     {
     }
     void calculate_forces() override;

@@ -29,7 +29,7 @@ import numpy as np
 from . import RunResult
 from . import missing
 from .lammps_family import box, boundary, fmt as _fmt, integrated, run_script, vec as _vec, work_folder
-from . import ramp_script
+from . import lid_script, ramp_script
 from .text_dumps import (atoms_dump, id_ranges, optional_dump, pair_record, recorded, run_lines, slips_dump,
                          stats_dump, timeseries)
 
@@ -145,6 +145,8 @@ class _Script:
             self.add(f"fix integrate {moving} nve/sphere" + (" disc" if d2 else ""))
         else:
             self.add(f"fix integrate {moving} nve")
+        if sc.lid is not None:
+            self.add(*lid_script.drive(sc))
         # imposed velocity components: no force along them, so they keep their start value
         # (one group per set of components: LAMMPS allows 32 groups)
         held = {}
@@ -261,7 +263,7 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
 def run_with(script_class, launcher, engine, scene, out_dir, progress, np_ranks):
     """A scene through `script_class`'s input script on `launcher` (the run of both LAMMPS
     adapters); the work folder is out_dir/<engine, lower case>."""
-    scene.refuse_unsupported(engine, ("periodic", "gravity_ramp", "bulk"))
+    scene.refuse_unsupported(engine, ("periodic", "gravity_ramp", "bulk", "lid"))
     work = work_folder(scene, out_dir, engine)
     script = script_class(scene, work)
     (work / "in.scene").write_text(script.text())

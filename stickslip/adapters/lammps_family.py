@@ -78,12 +78,18 @@ def gravity(scene):
 def integrated(scene, ids):
     """The group to integrate, and the lines that make it: fixed grains are not integrated
     (they keep their place and zero velocity and spin), and two of them never act on each
-    other, so their pairs are kept out of the neighbour list."""
+    other, so their pairs are kept out of the neighbour list; a driven lid's grains (group lid)
+    move as one body of their own (lid_script.py), which never acts on itself either."""
     fixed = [ids[g.name] for g in scene.grains if g.fixed]
-    if not fixed:
+    lid = (["group lid id " + id_ranges([ids[n] for n in scene.lid.names]), "neigh_modify exclude group lid lid"]
+           if scene.lid is not None else [])
+    if not fixed and not lid:
         return "all", []
-    return "moving", ["group fixed id " + id_ranges(fixed), "group moving subtract all fixed",
-                      "neigh_modify exclude group fixed fixed"]
+    if not fixed:
+        return "moving", lid + ["group moving subtract all lid"]
+    return "moving", (["group fixed id " + id_ranges(fixed)] + lid[:1]
+                      + [f"group moving subtract all fixed{' lid' if lid else ''}",
+                         "neigh_modify exclude group fixed fixed"] + lid[1:])
 
 
 def work_folder(scene, out_dir, engine):

@@ -21,7 +21,7 @@ from . import RunResult
 from .text_dumps import full_precision as _full_precision, id_ranges as _id_ranges
 from . import missing
 from .lammps_family import box, boundary, fmt as _fmt, integrated, run_script, vec as _vec, work_folder
-from . import ramp_script
+from . import lid_script, ramp_script
 from .text_dumps import atoms_dump, optional_dump, pair_record, recorded, run_lines, slips_dump, stats_dump, timeseries
 
 NAME = "liggghts"
@@ -162,6 +162,8 @@ class _Script:
         self.moving = moving
         self.add(*lines)
         self.add(f"fix integrate {moving} nve/sphere" if eff["rotation"] else f"fix integrate {moving} nve")
+        if sc.lid is not None:
+            self.add(*lid_script.drive(sc))
         for g in sc.grains:
             if g.imposed:
                 comps = " ".join("0.0" if c in g.imposed else "NULL" for c in "xyz")
@@ -261,7 +263,7 @@ def _timeseries(script, work):
 
 
 def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
-    scene.refuse_unsupported("LIGGGHTS", ("periodic", "gravity_ramp", "rolling", "bulk"))
+    scene.refuse_unsupported("LIGGGHTS", ("periodic", "gravity_ramp", "rolling", "bulk", "lid"))
     work = work_folder(scene, out_dir, "LIGGGHTS")
     script = _Script(scene, work)
     (work / "in.scene").write_text(script.text())

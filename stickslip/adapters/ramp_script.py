@@ -26,6 +26,7 @@ import math
 
 import numpy as np
 
+from .. import columns
 from . import lammps_family
 from .lammps_family import fmt as _fmt
 
@@ -42,17 +43,20 @@ def bulk_variables(scene, group):
 
 
 def bulk_dump(scene, moving, precision):
-    """The lines that write `bulk.dump` (when the scene has a ramp or output.bulk): the bulk
-    variables of the group `moving`, then on grain 1's row (a group of one atom) the ramp's
-    angle and phase and the bulk columns, per row (atom-style copies of equal-style
-    variables). precision(dump, ncols): the engine's dump_modify line for full precision."""
-    if not (scene.output.bulk or scene.gravity_ramp is not None):
+    """The lines that write `bulk.dump` (when the scene has a ramp, output.bulk or a lid): the
+    bulk variables of the group `moving`, then on grain 1's row (a group of one atom) the ramp's
+    angle and phase, the bulk columns and the lid's (lid_script.drive's variables), per row
+    (atom-style copies of equal-style variables). precision(dump, ncols): the engine's
+    dump_modify line for full precision."""
+    if not (scene.output.bulk or scene.gravity_ramp is not None or scene.lid is not None):
         return []
     names = []
     if scene.gravity_ramp is not None:
         names += ["rp_th", "rp_ph"]
     if scene.output.bulk:
         names += [f"bk_c{a}" for a in "xyz"] + [f"bk_v{a}" for a in "xyz"]
+    if scene.lid is not None:
+        names += list(columns.LID)
     return (bulk_variables(scene, moving) + ["group bk_one id 1"] + [f"variable a_{n} atom v_{n}" for n in names]
             + [f"dump bulk bk_one custom {scene.output.every} bulk.dump id " + " ".join(f"v_a_{n}" for n in names),
                precision("bulk", len(names) + 1)])

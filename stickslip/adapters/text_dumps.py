@@ -238,14 +238,14 @@ def timeseries(engine, script, work, contact_record, slip_fn_col):
     if sc.output.slip_stats:
         cols.update(zip(columns.SLIP_STATS,
                         slip_stats(script, atoms, read_dump(work / "slips.dump"), steps, fn_col=slip_fn_col)))
-    if sc.output.bulk or sc.gravity_ramp is not None:
-        # bulk.dump (ramp_script.bulk_dump): id, then tilt and phase (a ramp), then BULK
+    if sc.output.bulk or sc.gravity_ramp is not None or sc.lid is not None:
+        # bulk.dump (ramp_script.bulk_dump): id, then tilt and phase (a ramp), BULK, LID (a lid)
         bulk = read_dump(work / "bulk.dump")
         names = (list(columns.RAMP) if sc.gravity_ramp is not None else []) + (
-            list(columns.BULK) if sc.output.bulk else [])
+            list(columns.BULK) if sc.output.bulk else []) + (list(columns.LID) if sc.lid is not None else [])
         values = np.array([bulk[s][0][1:1 + len(names)] for s in steps]).reshape(len(steps), len(names))
         got = dict(zip(names, values.T))
-        for name in columns.BULK + columns.RAMP:  # in columns.names' order
+        for name in columns.BULK + columns.LID + columns.RAMP:  # in columns.names' order
             if name in got:
                 cols[name] = np.rint(got[name]).astype(int) if name == "phase" else got[name]
     df = pd.DataFrame(cols)

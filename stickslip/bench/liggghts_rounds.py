@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """Time, interleaved chunk by chunk (stickslip/bench/liggghts.py): in each round every
 configuration runs as its own LIGGGHTS process, stopped by a shell probe after its warm-up
 and after every chunk of CHUNK steps; one process goes at a time, so a block (the same chunk

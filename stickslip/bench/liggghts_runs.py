@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """The LIGGGHTS benchmark's runs (stickslip/bench/liggghts.py): the settled packing (made once,
 cached under build/liggghts_bench/), the input script of every configuration of the
 tangential model, and running one (the plugin's launcher, alone or under mpirun) with what

@@ -24,9 +24,9 @@ A kind module provides (the contract; report, precision and analysis only loop):
 from __future__ import annotations
 
 from ..errors import SceneError
-from . import drag, drum, heap3d, hold3d, incline3d, none, tilt, tray
+from . import drag, drum, heap3d, hold3d, incline3d, none, shear3d, tilt, tray
 
-KINDS = {k.NAME: k for k in (none, drag, tray, tilt, drum, incline3d, hold3d, heap3d)}
+KINDS = {k.NAME: k for k in (none, drag, tray, tilt, drum, incline3d, hold3d, heap3d, shear3d)}
 
 
 def get(name):

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
 """What kinds share for `stickslip precision`: a run's figures as relative errors against
 the converged reference run's."""
 

@@ -112,6 +112,21 @@ class GravityRamp:
 
 
 @dataclass
+class Lid:
+    """A rough lid on a bed in a box periodic in x and y ([lid], docs/scene-format.md): its
+    grains move together as one body in translation (no spin), pressed along -z by `pressure`
+    (Pa: N/m^2, beyond their own weight) over the box's `area`, and pulled along x by a spring
+    of `stiffness` (N/m) whose far end moves at `velocity` (m/s) from `start` (s), at rest
+    before: a shear cell driven through a spring."""
+    names: tuple
+    pressure: float
+    stiffness: float
+    velocity: float
+    start: float
+    area: float
+
+
+@dataclass
 class Scene:
     name: str
     description: str
@@ -136,6 +151,7 @@ class Scene:
     # 3D: axis -> (lo, hi) of the periodic box along x and/or y (grains leaving at hi come back at lo)
     periodic: dict = field(default_factory=dict)
     gravity_ramp: GravityRamp | None = None
+    lid: Lid | None = None
 
     def gravity_angle(self, t) -> float:
         """The angle gravity has turned by at time t, rad."""
@@ -173,6 +189,8 @@ class Scene:
             out["rolling"] = "rolling resistance (contact.rolling)"
         if self.output.bulk:
             out["bulk"] = "the bulk columns (output.bulk)"
+        if self.lid is not None:
+            out["lid"] = "a driven lid (lid)"
         return out
 
     def refuse_unsupported(self, engine, supported=()):
@@ -182,7 +200,13 @@ class Scene:
             raise ValueError(f"{engine} cannot run scene {self.name}: it does not support {', '.join(missing)}")
 
     def moving_grains(self) -> list:
-        return [g for g in self.grains if not g.fixed]
+        """The grains integrated one by one: neither fixed nor a driven lid's."""
+        lid = set(self.lid.names) if self.lid is not None else ()
+        return [g for g in self.grains if not g.fixed and g.name not in lid]
+
+    def lid_grains(self) -> list:
+        lid = set(self.lid.names) if self.lid is not None else ()
+        return [g for g in self.grains if g.name in lid]
 
     @property
     def steps(self) -> int:

@@ -7,6 +7,7 @@ read, so they are checked by the same rules and named the same way.
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -22,7 +23,7 @@ from ..errors import SceneError
 from .grains import (MAX_GRAINS, base, base_count, block_count, check_mass, check_periodic, check_start, fill,
                      initial_spin, lattice, lattice_counts,
                      ring)
-from .model import Contact, GravityRamp, Grain, Output, RampPhase, Scene, Wall, WallRotation
+from .model import Contact, GravityRamp, Grain, Lid, Output, RampPhase, Scene, Wall, WallRotation
 from .stability import stability_limits
 from .table import Table, finite, shown, unique
 
@@ -170,7 +171,9 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
     if bases and dim != 3:
         raise SceneError("base: a rough base of spheres is made in 3D scenes only (dimension = 3)")
     base_counts = [base_count(t, periodic) for t in bases]
-    n_grains = (len(grain_tables) + sum(math.prod(c) for c in counts)
+    lid_slab, drive = _lid(top, dim, periodic)
+    lid_count = base_count(lid_slab, periodic) if lid_slab is not None else 0
+    n_grains = (len(grain_tables) + sum(math.prod(c) for c in counts) + lid_count
                 + sum(block_count(t) for t in rings) + sum(block_count(t) for t in fills) + sum(base_counts))
     if n_grains > MAX_GRAINS:
         raise SceneError(f"grain, lattice[].counts: {n_grains:.3g} grains; at most {MAX_GRAINS:.0e} per scene "
@@ -201,6 +204,12 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
         grains.extend(fill(ft))
     for bt, n in zip(bases, base_counts):
         grains.extend(base(bt, n, periodic))
+    lid = None
+    if lid_slab is not None:  # a base's slab, its grains free to move (together: the adapters)
+        lid_grains = [dataclasses.replace(g, fixed=False) for g in base(lid_slab, lid_count, periodic)]
+        grains.extend(lid_grains)
+        area = (periodic["x"][1] - periodic["x"][0]) * (periodic["y"][1] - periodic["y"][0])
+        lid = Lid(tuple(g.name for g in lid_grains), *drive, area)
     if not grains:
         raise SceneError("grain: a scene needs at least one [[grain]] or [[lattice]]")
     unique([g.name for g in grains], "grain.name")
@@ -242,7 +251,7 @@ def parse(data: dict, source=None, overrides=None) -> Scene:
     top.done()
 
     scene = Scene(name, description, dim, effects, gravity, contact, dt, duration,
-                  grains, walls, output, analysis, source, gravity_rate, spinup, periodic, ramp)
+                  grains, walls, output, analysis, source, gravity_rate, spinup, periodic, ramp, lid)
     if contact.rolling and not effects["rotation"]:
         raise SceneError(f"contact.rolling = {contact.rolling!r}: rolling resistance acts on spins; set "
                          "effects.rotation = true")
@@ -403,6 +412,25 @@ def _periodic(top: Table, dim):
     if not out:
         raise SceneError("periodic: give x = [lo, hi] and/or y = [lo, hi]")
     return out
+
+
+LID_DRIVE = ("pressure", "stiffness", "velocity", "start")
+
+
+def _lid(top: Table, dim, periodic):
+    """[lid]: (a Table of its slab for grains.base: origin, thickness, number_density, radius,
+    density, seed, prefix "lid"; (pressure, stiffness, velocity, start)), or (None, None)."""
+    if "lid" not in top.data:
+        return None, None
+    raw = top.get("lid")
+    lt = Table(raw, "lid")
+    if dim != 3 or set(periodic) != {"x", "y"}:
+        raise SceneError("lid: a driven lid spans a box periodic in x and y (dimension = 3, [periodic] x and y)")
+    drive = (lt.number("pressure", required=True, lo=0), lt.number("stiffness", required=True, lo=0, lo_open=True),
+             lt.number("velocity", required=True), lt.number("start", 0.0, lo=0))
+    if "size" in raw:
+        raise SceneError("lid.size: a lid spans the periodic box (leave size out)")
+    return Table({"prefix": "lid", **{k: v for k, v in raw.items() if k not in LID_DRIVE}}, "lid"), drive
 
 
 def _gravity_ramp(top: Table, dim, effects, gravity, gravity_rate):

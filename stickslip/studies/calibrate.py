@@ -2,8 +2,9 @@
 """`stickslip calibrate`: mu_s and mu_k for what a user measured on their material, from the map
 `stickslip study-3d` measured (docs/granular-3d/points.csv; docs/granular-3d.md).
 
-The targets: two or more of theta_start, theta_stop (incline), theta_heap (heap) and
-shear_drop (the sheared layer's stick-slip, once the map has it), each a value with its
+The targets: two or more of theta_start, theta_stop (incline), theta_heap (heap), shear_peak,
+shear_steady (the sheared layer's tau/sigma) and shear_dilation (its lid's rise, in grain
+diameters), the last three once the map has them, each a value with its
 standard error (--theta-start-se ...; none: exact), or a CSV of repeated measurements (a
 column per target, one row per repeat, n >= 2: the mean and its standard error std/sqrt(n),
 with n - 1 degrees of freedom). The map: calibrate_map.py (its points and the interpolation
@@ -30,7 +31,7 @@ from . import calibrate_fit, calibrate_map
 DOCS = shipped.path("docs/granular-3d")
 TARGETS = calibrate_map.TARGETS
 OPTION = calibrate_fit.OPTION
-UNIT = {"shear_drop": ""}  # the angles are in degrees
+UNIT = {"shear_peak": "", "shear_steady": "", "shear_dilation": " d"}  # the angles are in degrees
 
 
 def read_measurements(path):
@@ -51,7 +52,7 @@ def read_measurements(path):
         if len(bad):
             raise SceneError(f"--measurements {path}: {c} = {bad.iloc[0]!r}: not a number")
         v = v.dropna().to_numpy(float)
-        lo, hi = (0.0, 90.0) if c.startswith("theta") else (0.0, 10.0)
+        lo, hi = (0.0, 90.0) if c.startswith("theta") else (-5.0, 5.0) if c == "shear_dilation" else (0.0, 5.0)
         if len(v) and not ((v > lo) & (v < hi)).all():
             raise SceneError(f"--measurements {path}: {c} = {v[~((v > lo) & (v < hi))][0]:g}: must be in "
                              f"({lo:g}, {hi:g})")
@@ -75,8 +76,8 @@ def targets_of(args):
             raise SceneError(f"{OPTION[a]} {v:g}: {a} is also in --measurements {args.measurements}; give it once")
         out[a] = calibrate_fit.Target(v, se or 0.0)
     if len(out) < 2:
-        raise SceneError("calibrate: give at least two of --theta-start, --theta-stop, --theta-heap, --shear-drop "
-                         "(or a --measurements file)")
+        raise SceneError("calibrate: give at least two of --theta-start, --theta-stop, --theta-heap, --shear-peak, "
+                         "--shear-steady, --shear-dilation (or a --measurements file)")
     return out
 
 
@@ -104,6 +105,11 @@ def _range_line(r, name, other):
     return text + ")"
 
 
+def _k(r, name):
+    dof = r.dof[name]
+    return f"k {math.sqrt(r.delta[name]):.2f} ({'known errors' if not math.isfinite(dof) else f'{dof:.1f} dof'})"
+
+
 def main(args):
     targets = targets_of(args)
     path = args.map or DOCS / "points.csv"
@@ -114,25 +120,24 @@ def main(args):
     print(_range_line(r, "mu_s", "mu_k"))
     print(_range_line(r, "mu_k", "mu_s"))
     print(f"2 mu_k - mu_s = {2 * r.mu_k - r.mu_s:.3f} (the force a slipping contact holds, over Fn)")
-    print("ranges: chi2 within 1 of its least, the other coefficient profiled (each one's own 68 %); the joint 68 % "
-          "region of (mu_s, mu_k) is chi2 within 2.30 of its least" + (" (drawn in --region-png)" if args.region_png
-                                                                       else " (--region-png draws it)"))
+    print(f"ranges: chi2 within k^2 of its least, the other coefficient profiled (each one's own 68 %: k = 1 for known "
+          f"errors), k Student's t at the degrees of freedom of the errors it comes from: mu_s {_k(r, 'mu_s')}, mu_k "
+          f"{_k(r, 'mu_k')}; the joint 68 % region of (mu_s, mu_k) is chi2 within {r.delta['joint']:.2f} of its least"
+          + (" (drawn in --region-png)" if args.region_png else " (--region-png draws it)"))
     print("targets: " + ", ".join(f"{a} {t.value:.2f}" + (f" +- {t.se:.2f}" if t.se else "") + UNIT.get(a, " deg")
                                   + (f" (mean of {t.n})" if t.n else "" if t.se else " (exact)")
                                   for a, t in targets.items()))
     s = calibrate_map.scores(rows)
     score = "; ".join(f"{m} {v:.2f}" for m, (v, _) in s.items() if np.isfinite(v))
     n = max((v[1] for v in s.values()), default=0)
-    print("the map there: " + ", ".join(f"{a} {v:.1f} +- {e:.1f}" + UNIT.get(a, " deg") for a, (v, e, _) in
+    print("the map there: " + ", ".join(f"{a} {v:.1f} +- {e:.1f}" + UNIT.get(a, " deg") for a, (v, e) in
                                           r.at_best.items())
           + f" (chi2 {r.chi2:.2f}); interpolation {surf.method}"
           + (f" (leave-one-out mean (residual/se)^2 on {n} points: {score})" if score else "")
           + f"; rolling resistance {args.rolling:g}, the paper's nu_s (0.8 nu_n), step mode; the scenes of "
             "docs/granular-3d.md")
-    print("errors: map, its interpolation's own (leave-one-out: " + ", ".join(
-        f"{t} {e:.2f}" for t, e in surf.interp.items()) + ") and target in quadrature, times Student's t at their "
-          "Welch-Satterthwaite degrees of freedom (" + ", ".join(f"{a} {r.at_best[a][2]:.2f}" for a in targets
-                                                                if a in r.at_best) + " at the answer)")
+    print("errors: the map's, its interpolation's own (leave-one-out: " + ", ".join(
+        f"{t} {e:.2f}{UNIT.get(t, ' deg')}" for t, e in surf.interp.items()) + ") and the target's in quadrature")
     lag_value, lag_se, how = lag
     print({"fixed": f"theta_stop at a fixed angle: the ramp's value + {lag_value:.1f} +- {lag_se:.1f} deg (its lag to "
                     "beds held at fixed angles, measured)",

@@ -4,22 +4,23 @@ the targets, each with its uncertainty, and ranges whose meaning is stated.
 
 On a grid over the law's triangle (mu_s / 2 <= mu_k <= mu_s) within the map's hull,
 
-    chi2(mu_s, mu_k) = sum over targets (map(mu) - target)^2 / (k^2 (se_map^2 + se_interp^2 + se_target^2))
+    chi2(mu_s, mu_k) = sum over targets (map(mu) - target)^2 / (se_map^2 + se_interp^2 + se_target^2)
 
 se_map: the map's prediction there (calibrate_map.predict: its points' fills), se_interp: the
 interpolation's own error (calibrate_map.interp_error, from leave-one-out), se_target: the
-user's (0: taken as exact). k is the coverage factor of the GUM (JCGM 100:2008, annex G):
-Student's t quantile of 84.13 % at the Welch-Satterthwaite degrees of freedom of that sum (a
-standard error from 3 fills is itself uncertain by about half; with known errors k = 1), so
-that +- k se holds 68.27 %.
+user's (0: taken as exact). The answer is the grid point of least chi2.
 
-The answer is the grid point of least chi2. Each coefficient's range is the extent of the
-region chi2 <= min + 1: the other coefficient profiled (minimised over), which is the 68.27 %
-interval of one parameter (Wilks: delta chi2 is chi2 with 1 degree of freedom). The joint
-68.27 % region of the two is chi2 <= min + 2.30 (2 degrees of freedom). Both hold where the
-map is near linear over the region and the errors Gaussian; a region that reaches the map's
-edge or the law's bounds is cut, and its range there is a bound, not a standard error
-(`cut`), which calibrate says.
+Each coefficient's range is the extent of the region chi2 <= least + k^2 with the other
+coefficient profiled (minimised over): with known errors k = 1, the 68.27 % interval of one
+parameter (Wilks: delta chi2 is chi2 with 1 degree of freedom). But a standard error from 3
+fills is itself uncertain by about half, so k is the coverage factor of the GUM (JCGM 100:2008,
+annex G): Student's t quantile of 84.13 % at the Welch-Satterthwaite degrees of freedom of the
+errors that coefficient comes from (each target's, weighted by how much of the coefficient's
+variance it carries at the answer: the map's local slopes). The joint 68.27 % region of the
+two is chi2 <= least + 2 F(0.6827; 2, nu) (2.30 for known errors, nu -> infinity), nu the
+smaller of the two coefficients'. Both hold where the map is near linear over the region and
+the errors Gaussian; a region that reaches the map's edge or the law's bounds is cut, and its
+range there is a bound, not a standard error (`cut`), which calibrate says.
 """
 from __future__ import annotations
 
@@ -33,11 +34,11 @@ from . import calibrate_map
 
 GRID = 0.0025  # grid step in mu
 COVER = 0.6827  # one standard error of a Gaussian
-DELTA_PROFILE = 1.0  # one coefficient, the other profiled: chi2 quantile 0.6827 with 1 dof
-DELTA_JOINT = 2.30  # the pair: chi2 quantile 0.6827 with 2 dof
+DELTA_PROFILE = 1.0  # one coefficient, the other profiled, known errors: chi2 quantile 0.6827 with 1 dof
+DELTA_JOINT = 2.30  # the pair, known errors: chi2 quantile 0.6827 with 2 dof
 JOINT_LIMIT = 9.0  # least chi2 above which the targets are not reachable together (3 standard errors)
 OPTION = {"theta_start": "--theta-start", "theta_stop": "--theta-stop", "theta_heap": "--theta-heap",
-          "shear_drop": "--shear-drop"}
+          "shear_peak": "--shear-peak", "shear_steady": "--shear-steady", "shear_dilation": "--shear-dilation"}
 
 
 @dataclass
@@ -117,7 +118,9 @@ class Result:
     surf: Surfaces
     ranges: dict  # {"mu_s": (lo, hi), "mu_k": (lo, hi)}
     cut: dict  # {("mu_s", "lo" | "hi"): "map" | "mu_k = mu_s" | "mu_k = mu_s / 2" (the law's bounds)}
-    at_best: dict  # {target: (mean, se with k, k)}
+    at_best: dict  # {target: (mean, se)} of the map at the answer
+    delta: dict  # {"mu_s" | "mu_k" | "joint": delta chi2 of its 68.27 %}
+    dof: dict  # {"mu_s" | "mu_k": Welch-Satterthwaite degrees of freedom}
 
     def delta_at(self, mu_s, mu_k):
         """chi2 - least chi2 at the grid point nearest (mu_s, mu_k) (inf off the map)."""
@@ -134,16 +137,63 @@ def reachable(surf):
 
 
 def _chi2(targets, surf):
-    chi2 = np.zeros(surf.pred[next(iter(targets))][0].shape)
+    """chi2 on the grid, and each target's total variance and its degrees of freedom there."""
+    chi2, var_nu = 0.0, {}
     for a, t in targets.items():
         mean, var, nu = surf.pred[a]
         nu_t = (t.n - 1.0) if t.n else math.inf
         tot = var + t.se ** 2
         with np.errstate(invalid="ignore", divide="ignore"):
             nu_all = tot ** 2 / (np.where(np.isfinite(nu), var ** 2 / nu, 0.0) + t.se ** 4 / nu_t)
-        k = coverage_factor(np.where(np.isfinite(nu_all), nu_all, np.inf))
-        chi2 = chi2 + (mean - t.value) ** 2 / (k ** 2 * tot)
-    return np.where(np.isfinite(chi2), chi2, np.inf)
+        var_nu[a] = (tot, np.where(np.isfinite(nu_all), nu_all, np.inf))
+        chi2 = chi2 + (mean - t.value) ** 2 / tot
+    return np.where(np.isfinite(chi2), chi2, np.inf), var_nu
+
+
+def _slopes(surf, a, best):
+    """d(target)/d(mu_s), d/d(mu_k) at the grid point `best`: central differences, one-sided at
+    the domain's edge (0 where neither neighbour is on the map)."""
+    mean = surf.pred[a][0]
+    out = []
+    for axis in (0, 1):
+        i = list(best)
+        vals = []
+        for step in (-1, 1):
+            j = list(best)
+            j[axis] += step
+            ok = 0 <= j[axis] < mean.shape[axis] and np.isfinite(mean[tuple(j)])
+            vals.append(mean[tuple(j)] if ok else None)
+        lo, hi = vals
+        c = mean[tuple(i)]
+        out.append((hi - lo) / (2 * GRID) if lo is not None and hi is not None else
+                   (hi - c) / GRID if hi is not None else (c - lo) / GRID if lo is not None else 0.0)
+    return out
+
+
+def thresholds(targets, surf, var_nu, best):
+    """({"mu_s", "mu_k", "joint": delta chi2}, {"mu_s", "mu_k": dof}): each coefficient's
+    variance at the answer is sum over targets c_a^2 var_a, c = (J' W J)^-1 J' W (J the map's
+    slopes, W = 1 / var): Welch-Satterthwaite's dof over those terms, and k^2 from it."""
+    from scipy.stats import f
+
+    names = list(targets)
+    jac = np.array([_slopes(surf, a, best) for a in names])
+    var = np.array([var_nu[a][0][best] for a in names])
+    nu = np.array([var_nu[a][1][best] for a in names])
+    try:
+        w = jac.T / var
+        c = np.linalg.solve(w @ jac, w)  # 2 x targets
+    except np.linalg.LinAlgError:
+        c = None
+    dof = {}
+    for i, p in enumerate(("mu_s", "mu_k")):
+        u = c[i] ** 2 * var if c is not None else np.zeros(len(names))
+        denom = float(np.sum(np.where(np.isfinite(nu), u ** 2 / nu, 0.0)))
+        dof[p] = float(u.sum() ** 2 / denom) if denom > 0 else math.inf
+    delta = {p: float(coverage_factor(dof[p])) ** 2 * DELTA_PROFILE for p in dof}
+    joint = min(dof.values())
+    delta["joint"] = float(2 * f.ppf(COVER, 2, joint)) if math.isfinite(joint) else DELTA_JOINT
+    return delta, dof
 
 
 def solve(targets, surf):
@@ -152,15 +202,15 @@ def solve(targets, surf):
     targets no point gives together within 3 standard errors."""
     missing = [a for a in targets if a not in surf.pred]
     if missing:
-        what = "shear3d measurements (stickslip study-3d --groups shear measures them)" if missing[0] == "shear_drop" \
-            else f"{missing[0]} measurements"
+        what = ("shear3d measurements (stickslip study-3d --groups shear measures them)"
+                if missing[0].startswith("shear") else f"{missing[0]} measurements")
         raise SceneError(f"{OPTION[missing[0]]}: the map has no {what}")
     for a, t in targets.items():
         lo, hi = np.nanmin(surf.pred[a][0]), np.nanmax(surf.pred[a][0])
         if not lo - 3 * t.se <= t.value <= hi + 3 * t.se:
             raise SceneError(f"{OPTION[a]} {t.value:g}: outside the measured map, which reaches {a} from {lo:.1f} to "
                              f"{hi:.1f} deg ({reachable(surf)})")
-    field = _chi2(targets, surf)
+    field, var_nu = _chi2(targets, surf)
     best = np.unravel_index(np.argmin(field), field.shape)
     chi2 = float(field[best])
     ms, mk = float(surf.ms[best[0]]), float(surf.mk[best[1]])
@@ -169,22 +219,20 @@ def solve(targets, surf):
         raise SceneError(f"{' '.join(f'{OPTION[a]} {t.value:g}' for a, t in targets.items())}: no (mu_s, mu_k) of "
                          f"the map gives these together within 3 standard errors (closest: mu_s {ms:.3f}, mu_k "
                          f"{mk:.3f}: {got} deg); {reachable(surf)}")
-    region = field <= chi2 + DELTA_PROFILE
+    delta, dof = thresholds(targets, surf, var_nu, best)
     inside = np.isfinite(field)
     ranges, cut = {}, {}
     for axis, name, values in ((0, "mu_s", surf.ms), (1, "mu_k", surf.mk)):
+        region = field <= chi2 + delta[name]
         idx = np.nonzero(region.any(axis=1 - axis))[0]
         ranges[name] = (float(values[idx.min()]), float(values[idx.max()]))
         for end, i, step in (("lo", idx.min(), -1), ("hi", idx.max(), 1)):
             where = _edge(surf, region, inside, axis, i, step)
             if where:
                 cut[name, end] = where
-    at_best = {}
-    for a, (mean, var, nu) in surf.pred.items():
-        if np.isfinite(mean[best]):
-            k = float(coverage_factor(nu[best]))
-            at_best[a] = (float(mean[best]), k * math.sqrt(var[best]), k)
-    return Result(ms, mk, chi2, field, surf, ranges, cut, at_best)
+    at_best = {a: (float(mean[best]), math.sqrt(var[best])) for a, (mean, var, _) in surf.pred.items()
+               if np.isfinite(mean[best])}
+    return Result(ms, mk, chi2, field, surf, ranges, cut, at_best, delta, dof)
 
 
 def _edge(surf, region, inside, axis, i, step):

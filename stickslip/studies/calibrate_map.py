@@ -34,8 +34,10 @@ from . import granular3d_tables
 
 # What calibrate can take as a target: the column of points.csv ("<target>_mean", "_se",
 # "_n") and the scene kind it is read on. The incline's and the heap's angles; the sheared
-# layer's (kind shear3d) stick-slip drop once the study has measured it on the map's points.
-KIND = dict(granular3d_tables.KIND, shear_drop="shear")
+# layer's peak and steady tau/sigma and its dilation (kind shear3d) once the study has measured
+# them on the map's points (its group "shear").
+KIND = dict(granular3d_tables.KIND, shear_peak="shear", shear_steady="shear", shear_dilation="shear")
+GROUPS = ("sweep", "shear")
 TARGETS = tuple(KIND)
 METHODS = ("linear", "quadratic")
 SE_FLOOR = 0.05  # deg: a point measured once has no se
@@ -80,11 +82,11 @@ def lag_of(path, pts):
 
 
 def from_points(pts, rolling, nu_s="paper"):
-    """{target: Points}: the sweep's points on LIGGGHTS at this rolling resistance, history
+    """{target: Points}: the map's points on LIGGGHTS at this rolling resistance, history
     (mu_s = mu_k) and the stick-slip pairs with the chosen nu_s in the step mode, as the
     ramp measured them (the lag to a fixed angle, common to every point, is added to the
     predictions: calibrate_fit.surfaces)."""
-    pts = pts[(pts["engine"] == "liggghts") & (pts["group"] == "sweep")]
+    pts = pts[(pts["engine"] == "liggghts") & pts["group"].isin(GROUPS)]
     rolls = sorted(pts["rolling"].unique())
     if not any(math.isclose(rolling, r, abs_tol=1e-9) for r in rolls):
         raise SceneError(f"--rolling {rolling:g}: the map was measured at rolling resistance "
@@ -93,7 +95,7 @@ def from_points(pts, rolling, nu_s="paper"):
     pts = pts[(pts.mu_s == pts.mu_k) | ((pts.nu_s == nu_s) & (pts.timing == "step"))]
     out = {}
     for target, kind in KIND.items():
-        if f"{target}_mean" not in pts:
+        if f"{target}_mean" not in pts or f"{target}_se" not in pts:
             continue
         p = pts[(pts.kind == kind) & np.isfinite(pts[f"{target}_mean"])]
         mean = p[f"{target}_mean"].to_numpy(float)
@@ -127,7 +129,7 @@ def weights(method, p, at):
     tri = _hull(p.xy)
     if tri is None:
         return w
-    simplex = tri.find_simplex(at, tol=1e-9)
+    simplex = tri.find_simplex(at)
     inside = simplex >= 0
     if method == "linear":
         t = tri.transform[simplex[inside]]

@@ -2,8 +2,8 @@
 """`stickslip calibrate --region-png FILE`: the answer's region on the map's (mu_s, mu_k) plane.
 
 The map's domain (the law's triangle within the measured hull) shaded, the measured points,
-the contour chi2 = least + 1 (whose extent along each axis is that coefficient's range) and
-chi2 = least + 2.30 (the joint 68 % region), and the answer. Where the contours meet the
+the contours chi2 = least + k^2 (whose extent along each axis is that coefficient's range:
+calibrate_fit.thresholds) and the joint 68 % region, and the answer. Where the contours meet the
 domain's edge the region is cut: its range there is a bound, which the figure shows.
 """
 from __future__ import annotations
@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 
 from ..plotstyle import pyplot, save
-from . import calibrate_fit
 
 
 def draw(r, targets, pts, rolling, path):
@@ -25,10 +24,13 @@ def draw(r, targets, pts, rolling, path):
     inside = np.isfinite(r.field)
     ax.contourf(s, k, inside.astype(float), levels=[0.5, 1.5], colors=["0.92"])
     delta = np.where(inside, r.field - r.chi2, 1e9)
-    cs = ax.contour(s, k, delta, levels=[calibrate_fit.DELTA_PROFILE, calibrate_fit.DELTA_JOINT],
-                    colors=["C0", "C1"], linestyles=["-", "--"])
-    ax.clabel(cs, fmt={calibrate_fit.DELTA_PROFILE: "Δχ² = 1", calibrate_fit.DELTA_JOINT: "Δχ² = 2.30 (68 %)"},
-              fontsize=7)
+    levels = {r.delta["mu_s"]: "μs's range", r.delta["mu_k"]: "μk's range", r.delta["joint"]: "joint 68 %"}
+    if abs(r.delta["mu_s"] - r.delta["mu_k"]) < 1e-6:
+        levels = {r.delta["mu_s"]: "ranges", r.delta["joint"]: "joint 68 %"}
+    order = sorted(levels)
+    cs = ax.contour(s, k, delta, levels=order, colors=[f"C{i}" for i in range(len(order))],
+                    linestyles=["-"] * (len(order) - 1) + ["--"])
+    ax.clabel(cs, fmt={v: f"Δχ² = {v:.2f} ({levels[v]})" for v in order}, fontsize=7)
     sweep = pts[(pts.engine == "liggghts") & (pts.group == "sweep") & np.isclose(pts["rolling"], rolling)]
     sweep = sweep.drop_duplicates(["mu_s", "mu_k"])
     ax.plot(sweep.mu_s, sweep.mu_k, "k.", ms=6, label="measured points")
@@ -45,7 +47,7 @@ def draw(r, targets, pts, rolling, path):
     ax.set_title("calibrate: " + ", ".join(f"{a} {t.value:.2f}" + (f" ± {t.se:.2f}" if t.se else "")
                                            for a, t in targets.items()) + f"; rolling {rolling:g}", fontsize=8)
     ax.legend(fontsize=7, loc="upper left")
-    fig.text(0.01, 0.01, "ranges (thin lines; dotted: cut by the domain's edge, a bound) from Δχ² = 1; "
+    fig.text(0.01, 0.01, "thin lines: each coefficient's range (dotted: cut by the domain's edge, a bound); "
              "grey: the map's domain", fontsize=6)
     save(fig, path.parent, path.name)
     return path

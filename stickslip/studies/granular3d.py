@@ -7,7 +7,10 @@ The matrix: cases/incline3d.toml (theta_start, theta_stop) and cases/heap3d.toml
 off and on, FILLS fills each (the base's and the bed's random seeds), on LIGGGHTS; the
 validation against Weinhart et al.'s h_stop (a 10 d and a 20 d bed, each also at half the
 ramp's rates: the ramp's lag); the check with Silbert et al.'s stiffer contact; LAMMPS on
-the validation and two stick-slip points. The cost is stated before the first run starts (COST, measured); each finished
+the validation and two stick-slip points; the map's denser points that calibrate inverts
+(MAP_PAIRS), its round trip on pairs off the map (COVERAGE_PAIRS, group "coverage":
+granular3d_calibration.py) and the sheared layer (cases/shear3d.toml, group "shear":
+granular3d_shear.py). `groups` (GROUPS) runs some of them. The cost is stated before the first run starts (COST, measured); each finished
 run stays on disk under `runs/<label>/` (summary.json and a small CSV: the ramp's series or
 the heap's profile) and an interrupted study resumes with the runs it has not finished.
 Then granular3d_tables.py writes the tables, figures and summary under `--out`.
@@ -50,6 +53,13 @@ MAP_PAIRS = PAIRS + ((0.2, 0.1), (0.35, 0.175), (0.5, 0.25), (0.65, 0.325), (0.8
 COVERAGE_PAIRS = ((0.27, 0.17), (0.27, 0.24), (0.43, 0.25), (0.43, 0.37), (0.57, 0.35), (0.57, 0.5),
                   (0.65, 0.45), (0.73, 0.45), (0.73, 0.64))
 COVERAGE_FILLS = (11, 12, 13)
+# The sheared layer (cases/shear3d.toml, kind shear3d): a measurement that might tell mu_s from
+# mu_k. Its sensitivity to mu_s - mu_k at fixed mu_k on two lines, mu_k = 0.2 (where the bulk
+# still feels the contacts' friction) and 0.35 (where the incline's angles have saturated),
+# mu_s - mu_k from 0 to the law's bound mu_s = 2 mu_k or 0.3; and on the map's points, so that
+# calibrate can take it as a target; LAMMPS repeats one point.
+SHEAR_LINES = ((0.2, 0.2), (0.3, 0.2), (0.4, 0.2), (0.35, 0.35), (0.45, 0.35), (0.55, 0.35), (0.65, 0.35))
+SHEAR_LAMMPS = (0.4, 0.2)
 # The paper's nu_s, as a share of nu_n: Table 2's 33.10 / 41.38 = 0.8. The scenes' nu_n
 # (restitution 0.88) makes it 6.325 m sqrt(g/d).
 NU_S_OVER_NU_N = 33.10 / 41.38
@@ -163,13 +173,18 @@ def _matrix(fills, checks, engines):
         jobs += _jobs_of("incline", "lammps", "validation", 0.5, 0.5, "0", "step", 0.0, fills)
         for mu_s, mu_k in LAMMPS_PAIRS:
             jobs += _jobs_of("incline", "lammps", "engines", mu_s, mu_k, "paper", "step", 0.0, fills)
-    for kind in ("incline", "heap"):  # calibrate's round trip: pairs off the map, fills it never used
+    for kind in ("incline", "heap", "shear"):  # calibrate's round trip: pairs off the map, fills it never used
         for mu_s, mu_k in COVERAGE_PAIRS:
             jobs += _jobs_of(kind, "liggghts", "coverage", mu_s, mu_k, "paper", "step", 0.0, COVERAGE_FILLS)
+    points = list(dict.fromkeys(SHEAR_LINES + tuple((m, m) for m in MUS) + MAP_PAIRS))
+    for mu_s, mu_k in points:
+        jobs += _jobs_of("shear", "liggghts", "shear", mu_s, mu_k, "0" if mu_s == mu_k else "paper", "step", 0.0, fills)
+    if "lammps" in engines:
+        jobs += _jobs_of("shear", "lammps", "engines", *SHEAR_LAMMPS, "paper", "step", 0.0, fills)
     return jobs
 
 
-SCENES = {"incline": "incline3d", "heap": "heap3d", "hold": "incline3d_hold"}
+SCENES = {"incline": "incline3d", "heap": "heap3d", "hold": "incline3d_hold", "shear": "shear3d"}
 
 
 def scene_data(job, base):
@@ -188,6 +203,8 @@ def scene_data(job, base):
         c.update(rolling="epsd2", rolling_mu=job.rolling)
     for block in data.get("base", []) + data.get("lattice", []):
         block["seed"] = job.fill
+    if "lid" in data:  # the lid's own slab: another seed than the base's
+        data["lid"]["seed"] = 100 + job.fill
     if job.layers:
         # a deeper bed: its flow's speed (Bagnold, ~h^1.5 at a given h/h_stop) and the time it
         # takes to reach it grow with depth, so the ramp's rates scale as (h/h0)^-1.5 (measured:
@@ -246,7 +263,7 @@ def estimate(job, sc):
     """CPU seconds a run takes (SECONDS_PER_GRAIN_STEP, INCLINE_TIME), only to say beforehand."""
     if job.kind == "incline":
         sim = INCLINE_TIME[bool(job.layers), job.rate_factor]
-    else:  # a heap; a held bed at most (one that stops ends its run)
+    else:  # a heap or a sheared layer; a held bed at most (one that stops ends its run)
         sim = sc.duration
     return SECONDS_PER_GRAIN_STEP[job.engine] * len(sc.grains) * sim / sc.dt
 
@@ -278,6 +295,8 @@ def run_one(job, sc, data, folder, keep_engine_files=False):
         keep = df[["t", "tilt", "phase", "com_z", "vcm_x", "vcm_y", "vcm_z", "ekin"]].copy()
         keep.insert(3, "speed", incline3d.downhill_speed(sc, df))
         keep.to_csv(tmp / "series.csv", index=False)
+    elif job.kind == "shear":
+        df[["t", "lid_x", "lid_z", "lid_vx", "lid_force"]].to_csv(tmp / "series.csv", index=False)
     else:
         xc, top = heap3d.profile(sc, df.iloc[-1])
         np.savetxt(tmp / "profile.csv", np.column_stack([xc, top]), delimiter=",", header="x,height", comments="")
@@ -297,9 +316,11 @@ def _task(job, sc, data, folder, keep):
 
 
 def run_study(out, out_runs, fills=FILLS, checks=True, engines=("liggghts", "lammps"), only=None, jobs_at_once=2,
-              progress=True, tables_only=False, keep_engine_files=False, jobs=None, scenes=None, groups=GROUPS):
+              progress=True, tables_only=False, keep_engine_files=False, jobs=None, scenes=None, groups=GROUPS,
+              cost_only=False):
     """The matrix (or `jobs`): the cost said first, `jobs_at_once` runs side by side, a line
-    per finished run, then the tables and figures of every finished run."""
+    per finished run, then the tables and figures of every finished run. cost_only: say the
+    cost, per group, and run nothing."""
     from . import granular3d_tables
     from .. import parallel
 
@@ -309,46 +330,79 @@ def run_study(out, out_runs, fills=FILLS, checks=True, engines=("liggghts", "lam
         if not jobs:
             raise SceneError(f"--only {' '.join(only)}: matches no run of the study")
     planned = plan(jobs, out_runs, scenes)
-    todo = [p for p in planned if not done(p[3], p[2], p[0].engine)]
+    kept = committed_rows(out, planned, out_runs)
+    from_table = {p[0].label for p in planned} & set(kept.label)
+    todo = [p for p in planned if not done(p[3], p[2], p[0].engine) and p[0].label not in from_table]
+    say = sys.stderr.write
+    if cost_only:
+        for group in dict.fromkeys(p[0].group for p in planned):
+            left = [p for p in todo if p[0].group == group]
+            say(f"stickslip study-3d: group {group}: {sum(p[0].group == group for p in planned)} runs, {len(left)} to "
+                f"run, {sum(estimate(p[0], p[1]) for p in left) / 3600:.2f} CPU hours\n")
     if not tables_only and todo:
         cost = {p[0].label: estimate(p[0], p[1]) for p in todo}
-        say = sys.stderr.write
-        say(f"stickslip study-3d: {len(planned)} runs, {len(planned) - len(todo)} already on disk in {out_runs}; "
+        say(f"stickslip study-3d: {len(planned)} runs, {len(planned) - len(todo) - len(from_table)} already on disk in "
+            f"{out_runs}, {len(from_table)} in {Path(out) / 'runs.csv'}; "
             f"{len(todo)} to run ({jobs_at_once} at once), about {sum(cost.values()) / 60 / jobs_at_once:.0f} min "
             f"({sum(cost.values()) / 3600:.1f} CPU hours)\n")
+        if cost_only:
+            return None
         t0 = time.perf_counter()
         tasks = [(cost[j.label], _task, (j, sc, data, folder, keep_engine_files)) for j, sc, data, folder in todo]
         results = parallel.run_all(tasks, "study-3d", progress, n_workers=jobs_at_once)
         failed = [(t[2][0].label, r) for t, r in zip(tasks, results) if isinstance(r, Exception)]
         say(f"stickslip study-3d: {len(todo) - len(failed)} runs finished in {(time.perf_counter() - t0) / 60:.1f} "
             "min" + (f"; {len(failed)} failed, first: {failed[0][0]}: {failed[0][1]}" if failed else "") + "\n")
+    if cost_only:
+        return None
     finished = [p for p in planned if done(p[3], p[2], p[0].engine)]
-    granular3d_tables.write_runs(finished, Path(out))
+    order = [j.label for j in matrix(fills, checks, engines, GROUPS)] + [p[0].label for p in planned]
+    granular3d_tables.write_runs(finished, Path(out), kept=kept, order=list(dict.fromkeys(order)))
     return write_results(out)
+
+
+def committed_rows(out, planned, out_runs):
+    """The rows of out/runs.csv (the committed table) that no run on disk replaces: the
+    finished runs of an earlier study, planned now or of groups not run now, kept as they
+    are (a label says everything a run depends on but the scene files, which a changed scene
+    does not invalidate here: delete its rows to run them again). So a study resumes in a
+    checkout without the earlier study's run folders, and a study of some groups keeps the
+    others' rows."""
+    import pandas as pd
+
+    path = Path(out) / "runs.csv"
+    if not path.is_file():
+        return pd.DataFrame({"label": []})
+    rows = pd.read_csv(path)
+    on_disk = {p[0].label for p in planned if done(p[3], p[2], p[0].engine)}
+    return rows[~rows.label.isin(on_disk)]
 
 
 def write_results(out):
     """The tables, figures and summary.md from out/runs.csv alone."""
-    from . import granular3d_calibration, granular3d_figures, granular3d_tables
+    from . import granular3d_calibration, granular3d_figures, granular3d_shear, granular3d_tables
 
     out = Path(out)
     tables = granular3d_tables.write_tables(out)
     trust = granular3d_calibration.write(out, tables["points.csv"])
-    tables.update(trust)
+    shear = granular3d_shear.write(out, tables["points.csv"])
+    tables.update(trust, **shear)
     figs = granular3d_figures.draw(out, tables)
-    (out / "summary.md").write_text(granular3d_tables.summary(tables, figs) + granular3d_calibration.markdown(trust))
+    (out / "summary.md").write_text(granular3d_tables.summary(tables, figs) + granular3d_calibration.markdown(trust)
+                                    + "\n" + granular3d_shear.markdown(shear))
     print(f"wrote {len(tables) + 1} tables, {len(figs)} figures and summary.md in {out}")
     return tables
 
 
 # The smoke study (the test suite, `study-3d --smoke`): small scenes, two materials, one fill.
-SMOKE_SCENES = {"incline": "incline3d_small", "heap": "heap3d_small"}
+SMOKE_SCENES = {"incline": "incline3d_small", "heap": "heap3d_small", "shear": "shear3d_small"}
 
 
 def smoke_jobs():
     """A study of a few seconds: history and one stick-slip pair on the small incline,
-    history on the small heap."""
+    history on the small heap, the pair on the small sheared layer."""
     return (_jobs_of("incline", "liggghts", "sweep", 0.5, 0.5, "0", "step", 0.0, (1,))
             + _jobs_of("incline", "liggghts", "sweep", 0.5, 0.35, "paper", "step", 0.0, (1,))
-            + _jobs_of("heap", "liggghts", "sweep", 0.5, 0.5, "0", "step", 0.0, (1,)))
+            + _jobs_of("heap", "liggghts", "sweep", 0.5, 0.5, "0", "step", 0.0, (1,))
+            + _jobs_of("shear", "liggghts", "shear", 0.5, 0.35, "paper", "step", 0.0, (1,)))
 

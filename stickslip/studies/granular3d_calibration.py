@@ -11,7 +11,8 @@
   (no leave-out needed: the pairs are not map points) and the row says whether the stated
   ranges hold the true mu_s, mu_k, and whether the true pair lies in the joint 68 % region.
   theta_stop is the ramp's on both sides: the lag to a fixed angle, common to both, cancels and
-  is left out. One row per pair and set of targets (TARGET_SETS);
+  is left out. One row per pair and set of targets (TARGET_SETS: the incline's two angles,
+  with the heap's, with the sheared layer's peak and steady tau/sigma and dilation);
 - coverage_summary.csv: per set of targets, how many ranges held the truth, against 68.27 %
   and its binomial spread sqrt(p (1 - p) / n), z = (held - n p) / sqrt(n p (1 - p)); a range cut
   by the map's edge or the law's bound is a bound, not a standard error, and is counted apart.
@@ -26,10 +27,12 @@ import pandas as pd
 from ..errors import SceneError
 from . import calibrate, calibrate_fit, calibrate_map
 
-TARGET_SETS = (("theta_start", "theta_stop"), ("theta_start", "theta_stop", "theta_heap"))
+TARGET_SETS = (("theta_start", "theta_stop"), ("theta_start", "theta_stop", "theta_heap"),
+               ("theta_start", "theta_stop", "shear_peak", "shear_steady", "shear_dilation"))
 P = calibrate_fit.COVER
 COLUMNS = ["targets", "mu_s", "mu_k", "fills", "theta_start", "theta_start_se", "theta_stop", "theta_stop_se",
-           "theta_heap", "theta_heap_se", "answer_mu_s", "mu_s_lo", "mu_s_hi", "answer_mu_k", "mu_k_lo", "mu_k_hi",
+           "theta_heap", "theta_heap_se", "shear_peak", "shear_peak_se", "shear_steady", "shear_steady_se", "shear_dilation",
+           "shear_dilation_se", "answer_mu_s", "mu_s_lo", "mu_s_hi", "answer_mu_k", "mu_k_lo", "mu_k_hi",
            "mu_s_held", "mu_k_held", "mu_s_cut", "mu_k_cut", "delta_chi2_true", "joint_held", "chi2", "interpolation",
            "refused"]
 
@@ -51,7 +54,7 @@ def loo_table(pts):
 
 
 def measured(cov):
-    """{(mu_s, mu_k): ({target: Target}, fills)} of the coverage points (incline and heap rows)."""
+    """{(mu_s, mu_k): ({target: Target}, fills)} of the coverage points (incline, heap, shear rows)."""
     out = {}
     for (mu_s, mu_k), grp in cov.groupby(["mu_s", "mu_k"]):
         t = {}
@@ -93,7 +96,7 @@ def coverage(pts, method="auto", surf=None):
                          "mu_k_held": k0 - tol <= mu_k <= k1 + tol,
                          "mu_s_cut": " ".join(f"{e}: {w}" for (n, e), w in r.cut.items() if n == "mu_s"),
                          "mu_k_cut": " ".join(f"{e}: {w}" for (n, e), w in r.cut.items() if n == "mu_k"),
-                         "delta_chi2_true": delta, "joint_held": delta <= calibrate_fit.DELTA_JOINT, "chi2": r.chi2,
+                         "delta_chi2_true": delta, "joint_held": delta <= r.delta["joint"], "chi2": r.chi2,
                          "refused": ""})
     return pd.DataFrame(rows, columns=COLUMNS)
 

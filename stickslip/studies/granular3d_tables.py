@@ -21,6 +21,8 @@ import pandas as pd
 
 ANGLES = ("theta_start", "theta_stop", "theta_heap")
 KIND = {"theta_start": "incline", "theta_stop": "incline", "theta_heap": "heap"}  # the scene each angle is read on
+# The sheared layer's figures (kind shear3d), in runs.csv, and in points.csv once a study ran it.
+SHEAR = ("shear_peak", "shear_steady", "shear_dilation", "slip_drop")
 # Weinhart et al. (2012, Granular Matter 14, 531), their fit of h_stop for a base of fixed
 # spheres of the flowing ones' size: h_stop = A d (tan d2 - tan theta) / (tan theta - tan d1).
 WEINHART = {"A": 3.836, "delta1": 17.561, "delta2": 32.257}
@@ -36,8 +38,9 @@ def weinhart_theta_stop(depth):
     return math.degrees(math.atan((a * t2 + depth * t1) / (a + depth)))
 
 
-def write_runs(finished, out):
-    """runs.csv (one row per finished run) from [(job, scene, data, folder)], then the rest."""
+def write_runs(finished, out, kept=None, order=None):
+    """runs.csv (one row per finished run) from [(job, scene, data, folder)] and the rows
+    `kept` of an earlier runs.csv (granular3d.committed_rows), in the labels' `order`."""
     rows = []
     for job, sc, _, folder in finished:
         s = json.loads((folder / "summary.json").read_text())
@@ -56,11 +59,17 @@ def write_runs(finished, out):
                      # the validation at fixed angles (kind hold3d): the held angle, did the bed stop, when
                      "hold_angle": s.get("theta_hold_deg", math.nan),  # as run: within one interval's turn
                      "stopped": s.get("stopped", math.nan), "time_to_stop": s.get("time_to_stop_s", math.nan),
-                     "speed_at_end": s.get("speed_at_end", math.nan), "speed_trend": s.get("speed_trend", math.nan)})
+                     "speed_at_end": s.get("speed_at_end", math.nan), "speed_trend": s.get("speed_trend", math.nan),
+                     **{k: s.get(k, math.nan) for k in SHEAR + ("shear_steady_sd", "slip_count")}})
         if job.kind == "hold" and s.get("stopped") == 1.0:
             rows[-1]["depth_at_stop"] = s["depth_at_end"]
     out.mkdir(parents=True, exist_ok=True)
     runs = pd.DataFrame(rows)
+    if kept is not None and len(kept):
+        runs = pd.concat([kept, runs], ignore_index=True)
+    if order is not None:
+        rank = {label: k for k, label in enumerate(order)}
+        runs = runs.sort_values("label", key=lambda c: c.map(rank), kind="stable", ignore_index=True)
     runs.to_csv(out / "runs.csv", index=False)
     return runs
 
@@ -72,9 +81,11 @@ def points(runs):
     for k in ("layers", "rate_factor", "silbert"):
         runs[k] = runs[k].fillna(0)
     rows = []
+    measured = ANGLES + ("depth_at_stop", "grains_per_area") + tuple(
+        k for k in SHEAR if k in runs and runs[k].notna().any())  # (the committed tables: none)
     for key, grp in runs.groupby(KEYS, sort=False, dropna=False):
         row = dict(zip(KEYS, key))
-        for a in ANGLES + ("depth_at_stop", "grains_per_area"):
+        for a in measured:
             v = grp[a].to_numpy(float)
             v = v[np.isfinite(v)]
             row[f"{a}_mean"] = float(v.mean()) if len(v) else math.nan
@@ -83,8 +94,7 @@ def points(runs):
             row[f"{a}_n"] = len(v)
         row["fills"] = len(grp)
         rows.append(row)
-    columns = KEYS + [f"{a}_{k}" for a in ANGLES + ("depth_at_stop", "grains_per_area")
-                      for k in ("mean", "std", "se", "n")] + ["fills"]
+    columns = KEYS + [f"{a}_{k}" for a in measured for k in ("mean", "std", "se", "n")] + ["fills"]
     return pd.DataFrame(rows, columns=columns)  # the columns even when only held beds ran
 
 

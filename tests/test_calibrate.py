@@ -1,0 +1,251 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Issue 51, `stickslip calibrate` with uncertainties: targets with their standard errors or a
+file of repeats, the map's interpolation chosen by leave-one-out, ranges with a stated meaning
+(delta chi2 = 1 profiled, 2.30 joint) flagged where the map's edge cuts them, the region's
+figure, and the round trip's coverage machinery (granular3d_calibration.py) on synthetic maps
+whose answers are known. The committed page's examples: test_granular3d.py."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from stickslip.cli import main
+from stickslip.studies import calibrate, calibrate_fit, calibrate_map, granular3d_calibration
+from test_granular3d import _synthetic_map
+
+SLOPE = 20.0  # deg per unit of mu_s: the synthetic map's theta_start = 20 + 20 mu_s
+
+
+def _surf(path, method="auto"):
+    return calibrate.prepare(calibrate_map.read_points(path), 0.0, method)[0]
+
+
+@pytest.fixture(scope="module")
+def synthetic(tmp_path_factory):
+    """The synthetic map's surfaces (made once: the leave-one-out and the grid take a while)."""
+    return _surf(_synthetic_map(tmp_path_factory.mktemp("synthetic")))
+
+
+@pytest.fixture(scope="module")
+def precise(tmp_path_factory):
+    return _surf(_precise_map(tmp_path_factory.mktemp("precise")))
+
+
+def _half_width(r, name):
+    lo, hi = r.ranges[name]
+    return (hi - lo) / 2
+
+
+def _precise_map(tmp_path):
+    """The synthetic map measured precisely: every point's se 0.01 (the floor, 0.05, counts)."""
+    path = _synthetic_map(tmp_path)
+    pts = pd.read_csv(path)
+    pts[[c for c in pts if c.endswith("_se")]] = 0.01
+    pts.to_csv(path, index=False)
+    return path
+
+
+@pytest.mark.parametrize("se, n, k", [(0.4, None, 1.0), (0.4, 3, 1.3213), (0.4, 2, 1.8374), (0.8, 4, 1.1969)])
+def test_a_range_is_the_target_error_over_the_slope_times_students_factor(precise, se, n, k):
+    """theta_start = 20 + 20 mu_s depends on mu_s alone, so with mu_k profiled (theta_stop met
+    by mu_k, within a grid step's 0.1 deg, well inside its 0.5) chi2 = k^2 where theta_start is off
+    by one error: on a precise map mu_s's half-range is k se_target / 20, k Student's t (84.13 %)
+    at n - 1 degrees of freedom (1 for a known error), to the grid's step."""
+    r = calibrate_fit.solve({"theta_start": calibrate_fit.Target(34.0, se, n),
+                             "theta_stop": calibrate_fit.Target(21.0, 0.5)}, precise)
+    assert (r.mu_s, r.mu_k) == pytest.approx((0.7, 0.5), abs=calibrate_fit.GRID)
+    assert _half_width(r, "mu_s") == pytest.approx(k * se / SLOPE, abs=calibrate_fit.GRID) and r.cut == {}
+
+
+def test_the_maps_error_is_its_points_weighted_mean(synthetic):
+    """An exact target on the map of se 0.3: the prediction there is a weighted mean of the
+    points (barycentric weights), its se sqrt(sum w^2) 0.3, from 0.3 / sqrt(3) at a triangle's
+    centre to 0.3 at a point; mu_s's half-range is that over the slope."""
+    surf = synthetic
+    r = calibrate_fit.solve({"theta_start": calibrate_fit.Target(34.0), "theta_stop": calibrate_fit.Target(21.0)},
+                            surf)
+    assert 0.3 / math.sqrt(3) / SLOPE - calibrate_fit.GRID < _half_width(r, "mu_s") < 0.3 / SLOPE + calibrate_fit.GRID
+    var = surf.pred["theta_start"][1]
+    assert np.nanmin(var) == pytest.approx(0.09 / 3, rel=0.01) and np.nanmax(var) == pytest.approx(0.09)
+
+
+def test_the_joint_region_is_wider_than_the_profiled_range(synthetic):
+    """Delta chi2 = 2.30 (two coefficients at 68 %, known errors) holds points that delta chi2 = 1
+    does not: along mu_s alone a point 1.2 half-ranges from the answer is outside the range and
+    inside the joint region (1.2^2 = 1.44 < 2.30)."""
+    r = calibrate_fit.solve({"theta_start": calibrate_fit.Target(34.0, 0.3),
+                             "theta_stop": calibrate_fit.Target(21.0, 0.3)}, synthetic)
+    h = _half_width(r, "mu_s")
+    k_best = r.mu_k + 0.5 * 1.2 * h  # theta_stop = 15 + 20 (2 mu_k - mu_s) unchanged
+    assert r.delta == {"mu_s": 1.0, "mu_k": 1.0, "joint": calibrate_fit.DELTA_JOINT}
+    assert 1.0 < r.delta_at(r.mu_s + 1.2 * h, k_best) < calibrate_fit.DELTA_JOINT
+
+
+def _ranges(out, name):
+    text = out.split(f"{name} = ")[1].split("\n")[0]
+    return float(text.split()[0]), [float(v) for v in text.split("profiled: ")[1].split(";")[0].rstrip(")").split(" to ")]
+
+
+def test_a_file_of_repeats_gives_the_mean_and_its_standard_error(tmp_path, capsys):
+    """Three repeats of theta_start around 34 (33.6, 34.0, 34.4: se 0.231) and two of theta_stop
+    (20.8, 21.2: se 0.2): the answer is the means', the targets line says what was taken; on a
+    precise map mu_s's range comes from theta_start's 3 repeats alone: Student's t at 2 dof."""
+    path = _precise_map(tmp_path)
+    (tmp_path / "m.csv").write_text("theta_start,theta_stop\n33.6,20.8\n34.0,21.2\n34.4,\n")
+    assert main(["calibrate", "--measurements", str(tmp_path / "m.csv"), "--map", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "targets: theta_start 34.00 +- 0.23 deg (mean of 3), theta_stop 21.00 +- 0.20 deg (mean of 2)" in out
+    ms, (lo, hi) = _ranges(out, "mu_s")
+    assert ms == pytest.approx(0.7, abs=0.005) and lo < 0.7 < hi
+    assert "chi2 within k^2 of its least, the other coefficient profiled" in out
+    k, dof = out.split("errors it comes from: mu_s k ")[1].split(" dof)")[0].split(" (")
+    assert 1.29 < float(k) < 1.33 and 2.0 <= float(dof) < 2.2  # the map's floor (0.05 deg) adds a little
+
+
+def test_the_range_cut_by_the_maps_edge_is_called_a_bound(tmp_path, capsys):
+    """A target near mu_s = 0.8 (theta_start 35.8 +- 0.6: mu_s 0.79 +- 0.03) reaches the map's
+    edge; one near mu_k = mu_s (theta_stop for mu_k = mu_s - 0.01) reaches the law's bound."""
+    path = _synthetic_map(tmp_path)
+    assert main(["calibrate", "--theta-start", "35.8", "--theta-start-se", "0.6", "--theta-stop", "20.8",
+                 "--map", str(path), "--region-png", str(tmp_path / "r.png")]) == 0
+    out = capsys.readouterr().out
+    assert "the range reaches the map's edge at mu_s = 0.800: a bound, not a standard error" in out
+    assert (tmp_path / "r.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f"wrote {tmp_path / 'r.png'}" in out
+    assert main(["calibrate", "--theta-start", "32", "--theta-stop", "26.8", "--theta-stop-se", "0.5",
+                 "--map", str(path)]) == 0
+    assert "the range reaches the law's bound mu_k = mu_s at mu_k = " in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--theta-start", "34", "--theta-start-se", "-1", "--theta-stop", "21"], "must be a standard error in [0, 90)"),
+    (["--theta-start", "34", "--theta-stop", "21", "--interpolation", "cubic"], "invalid choice: 'cubic'"),
+    (["--theta-start", "34", "--theta-stop-se", "0.3", "--theta-heap", "22"], "--theta-stop-se 0.3: give --theta-stop "
+                                                                            "too"),
+    (["--measurements", "m.csv", "--theta-start", "34"], "--theta-start 34: theta_start is also in --measurements"),
+    (["--measurements", "bad_column.csv"], "column 'theta_go': the columns must be among theta_start, theta_stop"),
+    (["--measurements", "one.csv"], "theta_stop has 1 value(s): needs n >= 2 repeats"),
+    (["--measurements", "text.csv"], "theta_stop = 'flat': not a number"),
+    (["--measurements", "range.csv"], "theta_start = 95: must be in (0, 90)"),
+    (["--measurements", "missing.csv"], "cannot be read as CSV"),
+    (["--theta-start", "34", "--shear-peak", "0.5"], "--shear-peak: the map has no shear3d measurements (stickslip "
+                                                      "study-3d --groups shear measures them)"),
+    (["--theta-start", "34", "--shear-steady", "7"], "must be a stress ratio in (0, 5)"),
+])
+def test_bad_calibrate_input_is_one_line_with_status_2(tmp_path, capsys, monkeypatch, argv, message):
+    path = _synthetic_map(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "m.csv").write_text("theta_start,theta_stop\n34,21\n34.2,21.2\n")
+    (tmp_path / "bad_column.csv").write_text("theta_start,theta_go\n34,21\n34.2,21.2\n")
+    (tmp_path / "one.csv").write_text("theta_start,theta_stop\n34,21\n34.2,\n")
+    (tmp_path / "text.csv").write_text("theta_start,theta_stop\n34,21\n34.2,flat\n")
+    (tmp_path / "range.csv").write_text("theta_start,theta_stop\n95,21\n34.2,21.1\n")
+    try:
+        code = main(["calibrate", *argv, "--map", str(path)])
+    except SystemExit as e:  # argparse's refusals
+        code = e.code
+    err = capsys.readouterr().err
+    assert code == 2 and message in err and err.count("\n") == 1, err
+
+
+def _curved_map(tmp_path, surface, mus=(0.2, 0.35, 0.5, 0.65, 0.8), se=0.05):
+    """A points.csv of the dense map's layout (history on the diagonal, and on each row of
+    mu_s a point on mu_k = mu_s / 2 and one half way) with theta_start = surface(mu_s, mu_k)."""
+    rows = []
+    for ms in mus:
+        for mk in (ms, ms / 2, 0.75 * ms):
+            rows.append({"kind": "incline", "engine": "liggghts", "group": "sweep", "mu_s": ms, "mu_k": round(mk, 4),
+                         "nu_s": "0" if mk == ms else "paper", "timing": "step", "rolling": 0.0,
+                         "theta_start_mean": surface(ms, mk), "theta_start_se": se,
+                         "theta_stop_mean": 15 + 20 * (2 * mk - ms), "theta_stop_se": se})
+    pd.DataFrame(rows).to_csv(tmp_path / "points.csv", index=False)
+    return calibrate_map.from_points(calibrate_map.read_points(tmp_path / "points.csv"), 0.0)
+
+
+def test_leave_one_out_chooses_the_interpolation_that_predicts_the_left_out_points(tmp_path):
+    """A quadratic surface is predicted exactly by the quadratic fit and not by the linear
+    triangulation (it curves between the points): quadratic chosen, its own error ~0. A surface
+    with a kink at mu_s = 0.35 (stock history's saturation) is not a quadratic: the linear one,
+    whose triangles end at the kink, predicts it better."""
+    rows = calibrate_map.loo(_curved_map(tmp_path, lambda s, k: 20 + 30 * s - 25 * s * s + 8 * s * k))
+    assert calibrate_map.choose(rows) == "quadratic"
+    err = calibrate_map.interp_error(rows)
+    assert err["theta_start", "quadratic"][0] < 0.01 < err["theta_start", "linear"][0]
+    q = rows[(rows.method == "quadratic") & (rows.target == "theta_start")]
+    assert np.nanmax(np.abs(q.residual)) < 1e-6 and np.isfinite(q.residual).sum() >= 9  # all but hull corners
+    rows = calibrate_map.loo(_curved_map(tmp_path, lambda s, k: 20 + 25 * min(s, 0.35) + 2 * s))
+    assert calibrate_map.choose(rows) == "linear"
+
+
+def test_the_interpolation_is_a_weighted_mean_of_the_points(tmp_path):
+    """Both interpolations give w . y with the weights summing to 1 (a constant surface is
+    reproduced) and the variance sum w^2 se^2: for the quadratic this is the fit's covariance."""
+    m = _curved_map(tmp_path, lambda s, k: 25.0, se=0.3)["theta_start"]
+    at = np.array([[0.6, 0.45], [0.3, 0.2], [0.9, 0.5]])
+    for method in calibrate_map.METHODS:
+        w = calibrate_map.weights(method, m, at)
+        assert np.allclose(w[:2].sum(axis=1), 1.0) and np.isnan(w[2]).all()  # (0.9, 0.5): outside the hull
+    a = calibrate_map._design(m.xy)
+    cov = np.linalg.inv(a.T @ (a / m.se[:, None] ** 2))
+    x = calibrate_map._design(at[:1])
+    _, var, _ = calibrate_map.predict(calibrate_map.weights("quadratic", m, at[:1]), m)
+    assert var[0] == pytest.approx((x @ cov @ x.T).item())
+
+
+def _coverage_points(rng, pairs, fills=3, spread=0.5):
+    """A planar map measured precisely (se 0.02) and `pairs` random true pairs inside it, each
+    measured on `fills` fills with a Gaussian spread per fill: the points of a study's tables."""
+    rows = []
+    for ms in (0.2, 0.35, 0.5, 0.65, 0.8):
+        for mk in (ms, ms / 2, 0.75 * ms):
+            rows.append({"kind": "incline", "group": "sweep", "mu_s": ms, "mu_k": mk, "nu_s": "paper",
+                         "theta_start_mean": 20 + 20 * ms, "theta_start_se": 0.02,
+                         "theta_stop_mean": 15 + 20 * (2 * mk - ms), "theta_stop_se": 0.02})
+    seen = set()
+    while len(seen) < pairs:  # distinct pairs on the grid
+        ms = round(rng.uniform(0.35, 0.7) / 0.0025) * 0.0025
+        mk = round(ms * (0.5 + 0.5 * rng.uniform(0.25, 0.75)) / 0.0025) * 0.0025
+        if (ms, mk) in seen:
+            continue
+        seen.add((ms, mk))
+        start = 20 + 20 * ms + spread * rng.standard_normal(fills)
+        stop = 15 + 20 * (2 * mk - ms) + spread * rng.standard_normal(fills)
+        rows.append({"kind": "incline", "group": "coverage", "mu_s": ms, "mu_k": mk, "nu_s": "paper", "fills": fills,
+                     "theta_start_mean": start.mean(), "theta_start_se": start.std(ddof=1) / math.sqrt(fills),
+                     "theta_start_n": fills, "theta_stop_mean": stop.mean(),
+                     "theta_stop_se": stop.std(ddof=1) / math.sqrt(fills), "theta_stop_n": fills})
+    return pd.DataFrame(rows).assign(engine="liggghts", timing="step", rolling=0.0, theta_heap_mean=np.nan)
+
+
+def test_the_round_trip_holds_the_truth_68_percent_of_the_time_on_a_known_map():
+    """On a planar map, pairs measured on 3 fills each (the user's measurement, n = 3): mu_s's
+    and mu_k's ranges and the joint region each hold the true pair in 68.27 % of 240 pairs, within
+    3 binomial standard deviations (0.030 each). Taking each target's se as exact (no Student
+    factor) would give ~58 %; leaving the target's se out of chi2, far less."""
+    pts = _coverage_points(np.random.default_rng(51), 240)
+    cov = granular3d_calibration.coverage(pts)
+    s = granular3d_calibration.summary(cov).set_index(["targets", "statement", "ranges"])
+    assert set(cov.targets) == {"theta_start+theta_stop"} and (cov.refused == "").all()
+    for statement in ("mu_s range", "mu_k range", "joint region"):
+        row = s.loc["theta_start+theta_stop", statement, "all"]
+        assert row.pairs == 240 and abs(row.share - calibrate_fit.COVER) < 3 * row.binomial_sd, (statement, row.share)
+    assert (cov.mu_s_cut == "").all()  # the truths are far from the edges: no range is cut
+
+
+def test_the_study_writes_the_round_trips_tables_per_pair(tmp_path):
+    """study-3d's tables of the round trip from points with coverage rows (synthetic series):
+    one row per pair and set of targets, the summary against 68.27 % with the binomial spread
+    of the number of pairs, the map's leave-one-out and the interpolation chosen."""
+    pts = _coverage_points(np.random.default_rng(1), 8)
+    tables = granular3d_calibration.write(tmp_path, pts)
+    cov = pd.read_csv(tmp_path / "coverage.csv")
+    assert len(cov) == 8 and set(cov.targets) == {"theta_start+theta_stop"} and cov.fills.eq(3).all()
+    s = pd.read_csv(tmp_path / "coverage_summary.csv")
+    assert set(s.statement) == {"mu_s range", "mu_k range", "joint region"} and s.pairs.eq(8).all()
+    assert s.binomial_sd.iloc[0] == pytest.approx(math.sqrt(0.6827 * 0.3173 / 8))
+    choice = pd.read_csv(tmp_path / "interpolation.csv")
+    assert choice.chosen.sum() == 1 and (tmp_path / "loo.csv").is_file()
+    md = granular3d_calibration.markdown(tables)
+    assert "how often its ranges hold the truth" in md and "chosen by leave-one-out" in md
