@@ -21,6 +21,7 @@ import numpy as np
 
 import law_contract as lc
 from stickslip import scene as scene_mod
+from stickslip.adapters.lammps_family import serial_mpi_env
 
 # YADE's law calls pyref's kernel (yade_law/stickslip_yade/kernel.py imports pyref/laws.py):
 # the law's arithmetic there is pyref's; its own tests check its geometry and integration.
@@ -199,8 +200,8 @@ def run_liggghts_script(script, work: Path):
 
     (work / "in.contract").write_text(script)
     # a serial run needs no MPI daemon: OpenMPI's isolated singleton starts none (measured:
-    # 0.35 s less a run, about half of a case's cost)
-    env = dict(os.environ, OMPI_MCA_ess_singleton_isolated="1")
+    # 0.35 s less a run, about half of a case's cost; stickslip/adapters/lammps_family.py)
+    env = dict(os.environ, **serial_mpi_env(work))
     proc = subprocess.run([str(LAUNCHER), "-in", "in.contract", "-echo", "none", "-log", "log.contract"],
                           cwd=work, capture_output=True, text=True, errors="replace", timeout=120, env=env)
     errors = [line for line in proc.stdout.split("\n") if line.startswith("ERROR")]

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from stickslip.adapters.lammps_family import serial_mpi_env
 from stickslip.adapters import lammps as lammps_adapter
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -42,8 +43,8 @@ def run_lammps(workdir, name, script, exe=None, np_=1, env=None, timeout=600, ch
     full_env = dict(os.environ, OMP_NUM_THREADS="1", **(env or {}))
     if np_ == 1:
         # Open MPI's singleton start-up without its daemon: ~0.4 s less per run (measured;
-        # nothing here spawns processes)
-        full_env["OMPI_MCA_ess_singleton_isolated"] = "1"
+        # nothing here spawns processes), its session directory the run's own
+        full_env.update(serial_mpi_env(workdir))
     else:
         cmd = ["mpirun", "-np", str(np_), "--oversubscribe"] + cmd
         full_env.update(MPI_ENV)

@@ -22,6 +22,7 @@ import pytest
 from conftest import skip_engine
 from stickslip.adapters import lammps as lammps_adapter
 from stickslip.adapters import liggghts as liggghts_adapter
+from stickslip.adapters.lammps_family import serial_mpi_env
 
 ROOT = Path(__file__).resolve().parent.parent
 HISTORY_PAGES = ("docs/performance.md", "docs/testing.md")  # dates allowed in their "## History"
@@ -328,7 +329,7 @@ def test_mu_s_range_is_the_codes_on_every_page():
 
 # --- the example inputs ---------------------------------------------------------------------
 
-MPI_SINGLETON = {"OMPI_MCA_ess_singleton_isolated": "1", "OMP_NUM_THREADS": "1"}
+MPI_SINGLETON = {"OMP_NUM_THREADS": "1"}  # (and serial_mpi_env: one process, no MPI daemon)
 SHORT = "2000"  # steps of a long example in the test: the input, its set-up and a first stretch
 
 
@@ -337,7 +338,7 @@ def run_example(exe, script, tmp_path, *args):
     shutil.copy(script, tmp_path / script.name)
     proc = subprocess.run([str(exe), "-in", script.name, "-log", "none", *args], cwd=tmp_path,
                           capture_output=True, text=True, errors="replace", timeout=120,
-                          env=dict(os.environ, **MPI_SINGLETON))
+                          env=dict(os.environ, **MPI_SINGLETON, **serial_mpi_env(tmp_path)))
     assert proc.returncode == 0 and "ERROR" not in proc.stdout, f"{script.name}:\n{proc.stdout[-2000:]}{proc.stderr[-2000:]}"
     return proc.stdout
 

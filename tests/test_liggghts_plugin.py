@@ -30,6 +30,7 @@ import pytest
 
 from conftest import needs_engine, skip_engine
 from stickslip.adapters.liggghts import LAUNCHER, PRELOAD
+from stickslip.adapters.lammps_family import serial_mpi_env
 
 ROOT = Path(__file__).resolve().parent.parent
 TEMPLATES = Path(__file__).resolve().parent / "liggghts"
@@ -68,8 +69,8 @@ def run_liggghts(tmp_path, name, script, exe=None, np_=1, env=None, timeout=600,
     exe = str(exe or LAUNCHER)
     cmd = [exe, "-in", f"in.{name}", "-log", f"log.{name}", "-echo", "none"]
     full_env = dict(os.environ, **(env or {}))
-    if np_ == 1:  # no MPI daemon for one process (stickslip/adapters/liggghts.py: 0.35 s a run)
-        full_env.setdefault("OMPI_MCA_ess_singleton_isolated", "1")
+    if np_ == 1:  # no MPI daemon for one process (stickslip/adapters/lammps_family.py: 0.35 s a run)
+        full_env.update({k: v for k, v in serial_mpi_env(tmp_path).items() if k not in full_env})
     if np_ > 1:
         cmd = ["mpirun", "-np", str(np_), "--oversubscribe"] + cmd
         full_env.update(MPI_ENV)

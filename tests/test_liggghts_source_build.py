@@ -28,6 +28,7 @@ import pytest
 
 from conftest import ENGINE_SKIP, skip_engine
 from stickslip.adapters.liggghts import LAUNCHER
+from stickslip.adapters.lammps_family import serial_mpi_env
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "liggghts_plugin" / "examples"
@@ -83,7 +84,7 @@ def run(exe, folder, script, extra=(), check=True):
     """Run `script` in `folder` with `exe`; returns (exit code, stdout)."""
     folder.mkdir()
     (folder / "in.case").write_text(script)
-    env = dict(os.environ, OMPI_MCA_ess_singleton_isolated="1")  # one process: no MPI daemon
+    env = dict(os.environ, **serial_mpi_env(folder))  # one process: no MPI daemon
     proc = subprocess.run([str(exe), "-in", "in.case", "-log", "none", *extra], cwd=folder, env=env,
                           capture_output=True, text=True, errors="replace", timeout=120)
     if check:

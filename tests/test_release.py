@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from conftest import skip_engine
+from stickslip.adapters.lammps_family import serial_mpi_env
 
 ROOT = Path(__file__).resolve().parent.parent
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
@@ -145,7 +146,7 @@ def test_each_plugin_launcher_prints_the_version_once_at_start(engine, tmp_path)
     (tmp_path / "in.empty").write_text("\n")
     proc = subprocess.run([str(adapters.get(engine).LAUNCHER), "-in", "in.empty", "-log", "log.txt"], cwd=tmp_path,
                           capture_output=True, text=True, timeout=60,
-                          env=dict(os.environ, OMPI_MCA_ess_singleton_isolated="1", OMP_NUM_THREADS="1"))
+                          env=dict(os.environ, **serial_mpi_env(tmp_path), OMP_NUM_THREADS="1"))
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for text in (proc.stdout, (tmp_path / "log.txt").read_text()):
         lines = [line for line in text.splitlines() if line.startswith("stickslip ")]

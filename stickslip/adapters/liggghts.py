@@ -20,7 +20,8 @@ import numpy as np
 from . import RunResult
 from .text_dumps import full_precision as _full_precision, id_ranges as _id_ranges
 from . import missing
-from .lammps_family import box, boundary, fmt as _fmt, integrated, run_script, vec as _vec, work_folder
+from .lammps_family import (box, boundary, fmt as _fmt, integrated, run_script, serial_mpi_env, vec as _vec,
+                            work_folder)
 from . import lid_script, ramp_script
 from .text_dumps import atoms_dump, optional_dump, pair_record, recorded, run_lines, slips_dump, stats_dump, timeseries
 
@@ -268,9 +269,7 @@ def run(scene, out_dir, progress=None, launcher=None, np_ranks=1):
     script = _Script(scene, work)
     (work / "in.scene").write_text(script.text())
     cmd = [str(launcher or LAUNCHER), "-in", "in.scene", "-log", "log.liggghts", "-echo", "none"]
-    # one process needs no MPI daemon: OpenMPI's isolated singleton starts none (0.35 s of
-    # every serial run, measured; same results)
-    loop_time = run_script("LIGGGHTS", cmd, work, scene.steps, progress, np_ranks,
-                           serial_env={"OMPI_MCA_ess_singleton_isolated": "1"})
+    # one process needs no MPI daemon (lammps_family.serial_mpi_env)
+    loop_time = run_script("LIGGGHTS", cmd, work, scene.steps, progress, np_ranks, serial_env=serial_mpi_env(work))
     df = _timeseries(script, work)
     return RunResult(df, ramp_script.steps_run(scene, df), loop_time)

@@ -56,6 +56,7 @@ import time
 from pathlib import Path
 
 from ..adapters.lammps import BUILD
+from ..adapters.lammps_family import serial_mpi_env
 from . import callgrind
 from .data_cache import cached_data
 from .proc_probe import probe_script
@@ -122,11 +123,11 @@ LOOP = re.compile(r"Loop time of (\S+) on (\d+) procs for (\d+) steps with (\d+)
 CPU_USE = re.compile(r"([\d.]+)% CPU use with")
 
 
-def _env(nproc=1):
+def _env(folder, nproc=1):
     env = dict(os.environ, OMP_NUM_THREADS="1")
     env.pop("LD_PRELOAD", None)
     if nproc == 1:
-        env["OMPI_MCA_ess_singleton_isolated"] = "1"  # no Open MPI daemon for a serial run
+        env.update(serial_mpi_env(folder))  # no Open MPI daemon for a serial run
     if hasattr(os, "geteuid") and os.geteuid() == 0:
         env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     return env
@@ -156,7 +157,7 @@ def _run(cmd, cwd, nproc=1, timeout=3600):
     cores: all cores' busy time less the command's own, over its wall time)."""
     b0, c0, t0 = _busy_seconds(), _children_cpu(), time.monotonic()
     p = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
-                       env=_env(nproc), timeout=timeout)
+                       env=_env(cwd, nproc), timeout=timeout)
     wall = time.monotonic() - t0
     own = _children_cpu() - c0  # (mpirun's ranks are its children: counted too)
     foreign = max(0.0, (_busy_seconds() - b0 - own) / wall) if wall > 0 else math.inf
@@ -247,7 +248,7 @@ def counted_run(d, script, cmd, groups):
     and for each name of `groups` the own instructions of the functions whose names hold
     one of its patterns}."""
     (d / "in.timed").write_text(script)
-    profile = callgrind.count(cmd, d, env=_env(), on_request=True)[-1]
+    profile = callgrind.count(cmd, d, env=_env(d), on_request=True)[-1]
     costs = callgrind.self_costs(profile)
     out = {name: sum(v for fn, v in costs.items() if any(p in fn for p in patterns))
            for name, patterns in groups.items()}

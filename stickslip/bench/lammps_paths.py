@@ -105,7 +105,7 @@ def _profile(config, steps, launcher, work):
     (d / "in.timed").write_text(bench._script(bench._pour(), steps, "shell ./callgrind_on.sh"))
     cmd = bench._command(config)
     cmd[0] = str(launcher)
-    return callgrind.count(cmd, d, env=bench._env(), on_request=True,
+    return callgrind.count(cmd, d, env=bench._env(d), on_request=True,
                            options=["--dump-instr=yes", "--dump-line=yes"])[-1]
 
 
