@@ -472,3 +472,22 @@ def test_deme_example_runs_on_a_gpu(tmp_path):
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     mean, count = mean_ratio(proc.stdout)
     assert abs(mean - DRAG_MEAN) <= DRAG_TOL and count == DRAG_SLIPS, (mean, count)
+
+
+CONSOLE = re.compile(r"```console\n\$ \.venv/bin/(stickslip calibrate[^\n]*)\n(.*?)```", re.S)
+
+
+def calibrate_examples():
+    """(page, command, the output the page shows) for every `stickslip calibrate` console block."""
+    found = [(p.relative_to(ROOT).as_posix(), m.group(1), m.group(2))
+             for p in markdown_files() for m in CONSOLE.finditer(p.read_text())]
+    return [pytest.param(*f, id=f"{f[0]}-{i}") for i, f in enumerate(found)]
+
+
+@pytest.mark.parametrize("page,command,shown", calibrate_examples())
+def test_calibrate_examples_print_what_the_page_shows(page, command, shown):
+    """calibrate's examples answer from the committed map: a map, an interpolation or a
+    message changed without its page would leave the page showing another answer."""
+    script = Path(sys.executable).parent / "stickslip"
+    proc = subprocess.run([str(script), *command.split()[1:]], cwd=ROOT, capture_output=True, text=True)
+    assert proc.stdout + proc.stderr == shown, page
