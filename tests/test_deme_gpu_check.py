@@ -142,13 +142,18 @@ class _BenchSolver:
     ShowThreadCollaborationStats)."""
 
     log = []
+    made = 0
 
     def __init__(self, *a):
         self.freq = None
+        # a serial number, not id(): a solver the bench has let go may leave its address to
+        # the next one, and two solvers would log as one
+        _BenchSolver.made += 1
+        self.serial = _BenchSolver.made
 
     def __getattr__(self, name):
         def call(*args):
-            _BenchSolver.log.append((id(self), name, args))
+            _BenchSolver.log.append((self.serial, name, args))
             if name == "SetCDUpdateFreq":
                 self.freq = args[0]
             return {"GetNumContacts": 1523200, "GetUpdateFreq": float(self.freq or 37.5),
