@@ -249,3 +249,24 @@ def test_the_study_writes_the_round_trips_tables_per_pair(tmp_path):
     assert choice.chosen.sum() == 1 and (tmp_path / "loo.csv").is_file()
     md = granular3d_calibration.markdown(tables)
     assert "how often its ranges hold the truth" in md and "chosen by leave-one-out" in md
+
+
+def test_targets_that_disagree_on_the_map_are_told(tmp_path, capsys):
+    """Three targets for two coefficients: the least chi2 at 1 degree of freedom says whether
+    they agree. On the synthetic map (0.7, 0.5) gives theta_start 34, theta_stop 21 and
+    theta_heap 22.8 (each se 0.3 on the map's points, 0.3 given): those agree (chi2 ~ 0);
+    theta_heap 1.2 deg off (f = 2 mu_k - mu_s from theta_stop 0.300, from theta_heap 0.375)
+    leaves chi2 ~ 7 at the compromise, p < 0.05, below the refusal at 9. Two targets: no line
+    (0 dof)."""
+    path = _synthetic_map(tmp_path)
+    given = ["--theta-start", "34", "--theta-start-se", "0.3", "--theta-stop", "21", "--theta-stop-se", "0.3",
+             "--map", str(path)]
+    assert main(["calibrate", *given]) == 0
+    assert "agreement:" not in capsys.readouterr().out
+    assert main(["calibrate", *given, "--theta-heap", "22.8", "--theta-heap-se", "0.3"]) == 0
+    line = next(t for t in capsys.readouterr().out.splitlines() if t.startswith("agreement:"))
+    assert float(line.split("p = ")[1].split(";")[0]) > 0.5 and "do not agree" not in line
+    assert main(["calibrate", *given, "--theta-heap", "24.0", "--theta-heap-se", "0.3"]) == 0
+    line = next(t for t in capsys.readouterr().out.splitlines() if t.startswith("agreement:"))
+    chi2 = float(line.split("least chi2 ")[1].split()[0])
+    assert 4.0 < chi2 < 9.0 and "do not agree with each other on the map" in line, line

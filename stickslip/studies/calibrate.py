@@ -28,6 +28,8 @@ from .. import shipped
 from ..errors import SceneError
 from . import calibrate_fit, calibrate_map
 
+AGREEMENT_P = 0.05  # the least chi2's tail probability below which the targets disagree
+
 DOCS = shipped.path("docs/granular-3d")
 TARGETS = calibrate_map.TARGETS
 OPTION = calibrate_fit.OPTION
@@ -110,6 +112,21 @@ def _k(r, name):
     return f"k {math.sqrt(r.delta[name]):.2f} ({'known errors' if not math.isfinite(dof) else f'{dof:.1f} dof'})"
 
 
+def _agreement_line(chi2, dof):
+    """With more targets than the two coefficients, the least chi2 tests whether the targets
+    agree with each other on the map: its tail probability at (targets - 2) degrees of freedom,
+    read as for known errors (errors from a few fills make the tail heavier: a p just below the
+    line is weak evidence)."""
+    from scipy.stats import chi2 as chi2_dist
+
+    p = float(chi2_dist.sf(chi2, dof))
+    text = f"agreement: least chi2 {chi2:.2f} at {dof} degree{'s' if dof > 1 else ''} of freedom (targets less 2), p = {p:.3f}"
+    if p < AGREEMENT_P:
+        text += (f"; below {AGREEMENT_P}: the targets do not agree with each other on the map (one may be off, or "
+                 "its error too small), and the ranges are narrower than they should be")
+    return text
+
+
 def main(args):
     targets = targets_of(args)
     path = args.map or DOCS / "points.csv"
@@ -127,6 +144,8 @@ def main(args):
     print("targets: " + ", ".join(f"{a} {t.value:.2f}" + (f" +- {t.se:.2f}" if t.se else "") + UNIT.get(a, " deg")
                                   + (f" (mean of {t.n})" if t.n else "" if t.se else " (exact)")
                                   for a, t in targets.items()))
+    if len(targets) > 2:
+        print(_agreement_line(r.chi2, len(targets) - 2))
     s = calibrate_map.scores(rows)
     score = "; ".join(f"{m} {v:.2f}" for m, (v, _) in s.items() if np.isfinite(v))
     n = max((v[1] for v in s.values()), default=0)
