@@ -80,16 +80,17 @@ def integrated(scene, ids):
     (they keep their place and zero velocity and spin), and two of them never act on each
     other, so their pairs are kept out of the neighbour list; a driven lid's grains (group lid)
     move as one body of their own (lid_script.py), which never acts on itself either."""
+    apart = {}  # group name -> its atom ids
     fixed = [ids[g.name] for g in scene.grains if g.fixed]
-    lid = (["group lid id " + id_ranges([ids[n] for n in scene.lid.names]), "neigh_modify exclude group lid lid"]
-           if scene.lid is not None else [])
-    if not fixed and not lid:
+    if fixed:
+        apart["fixed"] = fixed
+    if scene.lid is not None:
+        apart["lid"] = [ids[n] for n in scene.lid.names]
+    if not apart:
         return "all", []
-    if not fixed:
-        return "moving", lid + ["group moving subtract all lid"]
-    return "moving", (["group fixed id " + id_ranges(fixed)] + lid[:1]
-                      + [f"group moving subtract all fixed{' lid' if lid else ''}",
-                         "neigh_modify exclude group fixed fixed"] + lid[1:])
+    return "moving", ([f"group {name} id {id_ranges(members)}" for name, members in apart.items()]
+                      + ["group moving subtract all " + " ".join(apart)]
+                      + [f"neigh_modify exclude group {name} {name}" for name in apart])
 
 
 def serial_mpi_env(folder):

@@ -56,22 +56,24 @@ def slips(scene, df, after):
 
 
 def summarise(scene, df):
-    t, ratio = stress_ratio(scene, df)
-    peak, steady = t <= scene.analysis["peak_until"], t >= scene.analysis["steady_after"]
+    sigma = normal_stress(scene)
+    t = df["t"].to_numpy(float) - scene.lid.start  # time since the drive started, every row
+    full = df["lid_force"].to_numpy(float) / (sigma * scene.lid.area)  # tau/sigma, every row
+    on = t > 0  # the rows after the drive started (stress_ratio's)
+    after = t >= scene.analysis["steady_after"]
+    peak, steady = on & (t <= scene.analysis["peak_until"]), on & after
     z = df["lid_z"].to_numpy(float)
-    first = int(np.searchsorted(df["t"].to_numpy(float), scene.lid.start))  # the drive's first row
+    first = int(np.searchsorted(t, 0.0))  # the drive's first row
     z0 = z[first] if first < len(z) else math.nan  # (a run that ends before the drive: none)
-    full = df["lid_force"].to_numpy(float) / (normal_stress(scene) * scene.lid.area)
     events = [(a, b) for a, b in slips(scene, df, scene.analysis["steady_after"]) if a > 0 and b + 1 < len(df)]
     drops = [full[a - 1] - full[b + 1] for a, b in events]
-    after = df["t"].to_numpy(float) - scene.lid.start >= scene.analysis["steady_after"]
-    return {"shear_peak": float(ratio[peak].max()) if peak.any() else math.nan,
-            "shear_steady": float(ratio[steady].mean()) if steady.any() else math.nan,
-            "shear_steady_sd": float(ratio[steady].std()) if steady.any() else math.nan,
+    return {"shear_peak": float(full[peak].max()) if peak.any() else math.nan,
+            "shear_steady": float(full[steady].mean()) if steady.any() else math.nan,
+            "shear_steady_sd": float(full[steady].std()) if steady.any() else math.nan,
             "shear_dilation": float(z[after].mean() - z0) if after.any() else math.nan,
             "slip_count": len(events), "slip_drop": float(np.mean(drops)) if drops else math.nan,
-            "normal_stress": normal_stress(scene),
-            "drive_travel": float(scene.lid.velocity * t[-1]) if len(t) else 0.0}
+            "normal_stress": sigma,
+            "drive_travel": float(scene.lid.velocity * t[on][-1]) if on.any() else 0.0}
 
 
 def errors(scene, summary, df, ref_summary, ref_df):

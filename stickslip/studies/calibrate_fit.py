@@ -154,9 +154,9 @@ def _slopes(surf, a, best):
     """d(target)/d(mu_s), d/d(mu_k) at the grid point `best`: central differences, one-sided at
     the domain's edge (0 where neither neighbour is on the map)."""
     mean = surf.pred[a][0]
+    c = mean[tuple(best)]
     out = []
     for axis in (0, 1):
-        i = list(best)
         vals = []
         for step in (-1, 1):
             j = list(best)
@@ -164,7 +164,6 @@ def _slopes(surf, a, best):
             ok = 0 <= j[axis] < mean.shape[axis] and np.isfinite(mean[tuple(j)])
             vals.append(mean[tuple(j)] if ok else None)
         lo, hi = vals
-        c = mean[tuple(i)]
         out.append((hi - lo) / (2 * GRID) if lo is not None and hi is not None else
                    (hi - c) / GRID if hi is not None else (c - lo) / GRID if lo is not None else 0.0)
     return out

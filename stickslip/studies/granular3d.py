@@ -345,14 +345,14 @@ def run_study(out, out_runs, fills=FILLS, checks=True, engines=("liggghts", "lam
             f"{out_runs}, {len(from_table)} in {Path(out) / 'runs.csv'}; "
             f"{len(todo)} to run ({jobs_at_once} at once), about {sum(cost.values()) / 60 / jobs_at_once:.0f} min "
             f"({sum(cost.values()) / 3600:.1f} CPU hours)\n")
-        if cost_only:
-            return None
-        t0 = time.perf_counter()
-        tasks = [(cost[j.label], _task, (j, sc, data, folder, keep_engine_files)) for j, sc, data, folder in todo]
-        results = parallel.run_all(tasks, "study-3d", progress, n_workers=jobs_at_once)
-        failed = [(t[2][0].label, r) for t, r in zip(tasks, results) if isinstance(r, Exception)]
-        say(f"stickslip study-3d: {len(todo) - len(failed)} runs finished in {(time.perf_counter() - t0) / 60:.1f} "
-            "min" + (f"; {len(failed)} failed, first: {failed[0][0]}: {failed[0][1]}" if failed else "") + "\n")
+        if not cost_only:
+            t0 = time.perf_counter()
+            tasks = [(cost[j.label], _task, (j, sc, data, folder, keep_engine_files)) for j, sc, data, folder in todo]
+            results = parallel.run_all(tasks, "study-3d", progress, n_workers=jobs_at_once)
+            failed = [(t[2][0].label, r) for t, r in zip(tasks, results) if isinstance(r, Exception)]
+            say(f"stickslip study-3d: {len(todo) - len(failed)} runs finished in "
+                f"{(time.perf_counter() - t0) / 60:.1f} min"
+                + (f"; {len(failed)} failed, first: {failed[0][0]}: {failed[0][1]}" if failed else "") + "\n")
     if cost_only:
         return None
     finished = [p for p in planned if done(p[3], p[2], p[0].engine)]

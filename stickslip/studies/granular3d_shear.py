@@ -23,14 +23,10 @@ OBSERVABLES = ("shear_peak", "shear_steady", "shear_dilation")
 
 
 def _fit(x, y, e):
-    """(slope, se) of a weighted least-squares line, or (nan, nan) without two values of x."""
-    ok = np.isfinite(y) & np.isfinite(e) & (e > 0)
-    if ok.sum() < 3 or len(np.unique(x[ok])) < 2:
-        return math.nan, math.nan
-    w = 1 / e[ok] ** 2
-    a = np.column_stack([np.ones(ok.sum()), x[ok]])
-    cov = np.linalg.inv(a.T @ (a * w[:, None]))
-    return float((cov @ (a.T @ (w * y[ok])))[1]), math.sqrt(cov[1, 1])
+    """(slope, se) of the weighted least-squares line (granular3d_tables.weighted_line), or
+    (nan, nan) where it has none."""
+    line = granular3d_tables.weighted_line(x, y, e)
+    return (float(line[1]), line[2]) if line is not None else (math.nan, math.nan)
 
 
 def sensitivity(pts):

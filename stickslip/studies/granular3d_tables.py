@@ -174,20 +174,30 @@ def hysteresis(pts):
         for variant in (("paper", "step"), ("0", "exact")):
             sel = inc[(inc["rolling"] == rolling) & ((inc.mu_s == inc.mu_k) | ((inc.nu_s == variant[0]) &
                                                                           (inc.timing == variant[1])))]
-            x = (sel.mu_s - sel.mu_k).to_numpy(float)
-            y = (sel.theta_start_mean - sel.theta_stop_mean).to_numpy(float)
-            e = np.hypot(sel.theta_start_se, sel.theta_stop_se).to_numpy(float)
-            ok = np.isfinite(y) & np.isfinite(e) & (e > 0)
-            if ok.sum() < 3 or len(np.unique(x[ok])) < 2:  # a slope needs two values of mu_s - mu_k
+            line = weighted_line((sel.mu_s - sel.mu_k).to_numpy(float),
+                                 (sel.theta_start_mean - sel.theta_stop_mean).to_numpy(float),
+                                 np.hypot(sel.theta_start_se, sel.theta_stop_se).to_numpy(float))
+            if line is None:
                 continue
-            w = 1 / e[ok] ** 2
-            a = np.column_stack([np.ones(ok.sum()), x[ok]])
-            cov = np.linalg.inv(a.T @ (a * w[:, None]))
-            coef = cov @ (a.T @ (w * y[ok]))
-            rows.append({"rolling": rolling, "nu_s": variant[0], "timing": variant[1], "points": int(ok.sum()),
-                         "slope_deg_per_unit_mu": coef[1], "slope_se": math.sqrt(cov[1, 1]),
-                         "z": coef[1] / math.sqrt(cov[1, 1]), "intercept_deg": coef[0]})
+            intercept, slope, slope_se, n = line
+            rows.append({"rolling": rolling, "nu_s": variant[0], "timing": variant[1], "points": n,
+                         "slope_deg_per_unit_mu": slope, "slope_se": slope_se, "z": slope / slope_se,
+                         "intercept_deg": intercept})
     return pd.DataFrame(rows)
+
+
+def weighted_line(x, y, e):
+    """(intercept, slope, the slope's standard error, points used) of the weighted least-squares
+    line through the points with finite y and e > 0 (weights 1 / e^2), or None with fewer than
+    three of them or one value of x (a slope needs two)."""
+    ok = np.isfinite(y) & np.isfinite(e) & (e > 0)
+    if ok.sum() < 3 or len(np.unique(x[ok])) < 2:
+        return None
+    w = 1 / e[ok] ** 2
+    a = np.column_stack([np.ones(ok.sum()), x[ok]])
+    cov = np.linalg.inv(a.T @ (a * w[:, None]))
+    coef = cov @ (a.T @ (w * y[ok]))
+    return coef[0], coef[1], math.sqrt(cov[1, 1]), int(ok.sum())
 
 
 def rolling_effect(pts):
