@@ -50,20 +50,16 @@ def _count(text):
     return _number(text, int, lambda v: 1 <= v <= 100, "in [1, 100]")
 
 
-def _angle(text):
-    return _number(text, float, lambda v: 0 < v < 90, "an angle in degrees, in (0, 90)")
+def _target(name):
+    """The type of calibrate's option for target `name`: a number within calibrate_fit.ALLOWED."""
+    from .studies.calibrate_fit import ALLOWED
+
+    lo, hi, what = ALLOWED[name]
+    return lambda text: _number(text, float, lambda v: lo < v < hi, f"{what}, in ({lo:g}, {hi:g})")
 
 
 def _nonnegative(text):
     return _number(text, float, lambda v: 0 <= v < 90, "a standard error in [0, 90)")
-
-
-def _ratio(text):
-    return _number(text, float, lambda v: 0 < v < 5, "a stress ratio in (0, 5)")
-
-
-def _dilation(text):
-    return _number(text, float, lambda v: -5 < v < 5, "in grain diameters, in (-5, 5)")
 
 
 def _folder(text):
@@ -178,17 +174,17 @@ def build_parser():
 
     cal = sub.add_parser("calibrate", help="mu_s and mu_k for target angles of a bed of spheres, from the measured "
                                            "map of study-3d (docs/granular-3d.md)")
-    cal.add_argument("--theta-start", type=_angle, help="angle at which a bed starts to flow, deg")
-    cal.add_argument("--theta-stop", type=_angle, help="angle at which a flowing bed stops, deg")
-    cal.add_argument("--theta-heap", type=_angle, help="angle of repose of a heap on a plate, deg")
-    cal.add_argument("--shear-peak", type=_ratio, help="peak shear over normal stress of a shear cell (kind shear3d; "
-                                                       "needs a map that measured it)")
-    cal.add_argument("--shear-steady", type=_ratio, help="steady shear over normal stress of a shear cell (kind "
-                                                         "shear3d; needs a map that measured it)")
-    cal.add_argument("--shear-dilation", type=_dilation, help="rise of a shear cell's lid under shear, in grain "
-                                                             "diameters (kind shear3d; needs a map that measured it)")
-    for name in ("theta-start", "theta-stop", "theta-heap", "shear-peak", "shear-steady", "shear-dilation"):
-        cal.add_argument(f"--{name}-se", type=_nonnegative, help=f"standard error of --{name} (default 0: exact)")
+    shear = "needs a map that measured it"
+    for name, what in (("theta_start", "angle at which a bed starts to flow, deg"),
+                       ("theta_stop", "angle at which a flowing bed stops, deg"),
+                       ("theta_heap", "angle of repose of a heap on a plate, deg"),
+                       ("shear_peak", f"peak shear over normal stress of a shear cell (kind shear3d; {shear})"),
+                       ("shear_steady", f"steady shear over normal stress of a shear cell (kind shear3d; {shear})"),
+                       ("shear_dilation", f"rise of a shear cell's lid under shear, in grain diameters (kind shear3d; "
+                                          f"{shear})")):
+        option = "--" + name.replace("_", "-")
+        cal.add_argument(option, type=_target(name), help=what)
+        cal.add_argument(f"{option}-se", type=_nonnegative, help=f"standard error of {option} (default 0: exact)")
     cal.add_argument("--measurements", type=Path, help="CSV of repeated measurements: a column per target "
                                                        "(theta_start, theta_stop, theta_heap, shear_peak, "
                                                        "shear_steady, shear_dilation), a row per "

@@ -113,10 +113,27 @@ def test_the_range_cut_by_the_maps_edge_is_called_a_bound(tmp_path, capsys):
                  "--map", str(path), "--region-png", str(tmp_path / "r.png")]) == 0
     out = capsys.readouterr().out
     assert "the range reaches the map's edge at mu_s = 0.800: a bound, not a standard error" in out
+    assert "edge:" not in out  # the answer, 0.79, is inside; only its range reaches the edge
     assert (tmp_path / "r.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f"wrote {tmp_path / 'r.png'}" in out
     assert main(["calibrate", "--theta-start", "32", "--theta-stop", "26.8", "--theta-stop-se", "0.5",
                  "--map", str(path)]) == 0
     assert "the range reaches the law's bound mu_k = mu_s at mu_k = " in capsys.readouterr().out
+
+
+def test_an_answer_on_the_maps_edge_is_told(tmp_path, capsys):
+    """theta_start 36.5 +- 0.6 on the synthetic map (20 + 20 mu_s: 36 at its edge mu_s = 0.8) is
+    within 3 standard errors of the map, so it is answered, at mu_s = 0.800, where the map stops:
+    calibrate says that the map does not bracket the answer. An answer on the law's bound mu_k =
+    mu_s (a history contact: theta_stop of mu_k = mu_s) is no edge of the map."""
+    path = _synthetic_map(tmp_path)
+    assert main(["calibrate", "--theta-start", "36.5", "--theta-start-se", "0.6", "--theta-stop", "20.8",
+                 "--map", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "edge: the least chi2 lies on the map's edge (mu_s 0.800, mu_k " in out and "mu_s = 0.800 (" in out
+    surf = _surf(path)
+    r = calibrate_fit.solve({"theta_start": calibrate_fit.Target(32.0), "theta_stop": calibrate_fit.Target(27.6, 0.5)},
+                            surf)
+    assert r.mu_k == pytest.approx(r.mu_s) and r.edge is None
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -128,11 +145,11 @@ def test_the_range_cut_by_the_maps_edge_is_called_a_bound(tmp_path, capsys):
     (["--measurements", "bad_column.csv"], "column 'theta_go': the columns must be among theta_start, theta_stop"),
     (["--measurements", "one.csv"], "theta_stop has 1 value(s): needs n >= 2 repeats"),
     (["--measurements", "text.csv"], "theta_stop = 'flat': not a number"),
-    (["--measurements", "range.csv"], "theta_start = 95: must be in (0, 90)"),
+    (["--measurements", "range.csv"], "theta_start = 95: must be an angle in degrees, in (0, 90)"),
     (["--measurements", "missing.csv"], "cannot be read as CSV"),
     (["--theta-start", "34", "--shear-peak", "0.5"], "--shear-peak: the map has no shear3d measurements (stickslip "
                                                       "study-3d --groups shear measures them)"),
-    (["--theta-start", "34", "--shear-steady", "7"], "must be a stress ratio in (0, 5)"),
+    (["--theta-start", "34", "--shear-steady", "7"], "must be a stress ratio, in (0, 5)"),
 ])
 def test_bad_calibrate_input_is_one_line_with_status_2(tmp_path, capsys, monkeypatch, argv, message):
     path = _synthetic_map(tmp_path)

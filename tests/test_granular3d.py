@@ -234,10 +234,11 @@ def _synthetic_map(tmp_path):
     return path
 
 
-def test_effective_mu_inverts_a_monotonic_stock_curve_only(tmp_path):
+def test_effective_mu_inverts_where_the_stock_curve_reaches_the_angle_once(tmp_path):
     """The mu at which stock history reaches a measured angle: linear between measured mus
-    (theta_stop = 15 + 20 mu on the synthetic map: 21 is mu 0.3); none where the curve
-    turns back or does not reach the angle."""
+    (theta_stop = 15 + 20 mu on the synthetic map: 21 is mu 0.3); none where the curve does not
+    reach the angle, or reaches it twice (bent back: 19, 22, 40, 31 at mu 0.2, 0.35, 0.5, 0.8
+    reaches 35 twice and 21 once)."""
     from stickslip.studies import granular3d_tables as tables
 
     pts = pd.read_csv(_synthetic_map(tmp_path), dtype={"nu_s": str})
@@ -245,7 +246,8 @@ def test_effective_mu_inverts_a_monotonic_stock_curve_only(tmp_path):
     assert math.isnan(tables.effective_mu(pts, "theta_stop", 0.0, 40.0))
     bent = pts.copy()
     bent.loc[(bent.mu_s == bent.mu_k) & (bent.mu_s == 0.5) & (bent.kind == "incline"), "theta_stop_mean"] = 40.0
-    assert math.isnan(tables.effective_mu(bent, "theta_stop", 0.0, 21.0))
+    assert math.isnan(tables.effective_mu(bent, "theta_stop", 0.0, 35.0))
+    assert tables.effective_mu(bent, "theta_stop", 0.0, 21.0) == pytest.approx(0.2 + 0.15 * 2 / 3)
 
 
 def test_calibrate_inverts_the_map(tmp_path, capsys):

@@ -54,9 +54,9 @@ def read_measurements(path):
         if len(bad):
             raise SceneError(f"--measurements {path}: {c} = {bad.iloc[0]!r}: not a number")
         v = v.dropna().to_numpy(float)
-        lo, hi = (0.0, 90.0) if c.startswith("theta") else (-5.0, 5.0) if c == "shear_dilation" else (0.0, 5.0)
+        lo, hi, what = calibrate_fit.ALLOWED[c]
         if len(v) and not ((v > lo) & (v < hi)).all():
-            raise SceneError(f"--measurements {path}: {c} = {v[~((v > lo) & (v < hi))][0]:g}: must be in "
+            raise SceneError(f"--measurements {path}: {c} = {v[~((v > lo) & (v < hi))][0]:g}: must be {what}, in "
                              f"({lo:g}, {hi:g})")
         if len(v) < 2:
             raise SceneError(f"--measurements {path}: {c} has {len(v)} value(s): needs n >= 2 repeats for a "
@@ -136,6 +136,9 @@ def main(args):
     r = calibrate_fit.solve(targets, surf)
     print(_range_line(r, "mu_s", "mu_k"))
     print(_range_line(r, "mu_k", "mu_s"))
+    if r.edge:
+        print(f"edge: the least chi2 lies on the map's edge (mu_s {r.mu_s:.3f}, mu_k {r.mu_k:.3f}): the map does not "
+              "bracket the answer, which may lie beyond it; read it as a bound and the region as what the targets allow")
     print(f"2 mu_k - mu_s = {2 * r.mu_k - r.mu_s:.3f} (the force a slipping contact holds, over Fn)")
     print(f"ranges: chi2 within k^2 of its least, the other coefficient profiled (each one's own 68 %: k = 1 for known "
           f"errors), k Student's t at the degrees of freedom of the errors it comes from: mu_s {_k(r, 'mu_s')}, mu_k "

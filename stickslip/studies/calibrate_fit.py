@@ -39,6 +39,11 @@ DELTA_JOINT = 2.30  # the pair, known errors: chi2 quantile 0.6827 with 2 dof
 JOINT_LIMIT = 9.0  # least chi2 above which the targets are not reachable together (3 standard errors)
 OPTION = {"theta_start": "--theta-start", "theta_stop": "--theta-stop", "theta_heap": "--theta-heap",
           "shear_peak": "--shear-peak", "shear_steady": "--shear-steady", "shear_dilation": "--shear-dilation"}
+# What a target may be, open bounds, and how the bound is said: the command's options and a file
+# of repeats (calibrate.read_measurements) both check these.
+ALLOWED = {"theta_start": (0.0, 90.0, "an angle in degrees"), "theta_stop": (0.0, 90.0, "an angle in degrees"),
+           "theta_heap": (0.0, 90.0, "an angle in degrees"), "shear_peak": (0.0, 5.0, "a stress ratio"),
+           "shear_steady": (0.0, 5.0, "a stress ratio"), "shear_dilation": (-5.0, 5.0, "in grain diameters")}
 
 
 @dataclass
@@ -121,6 +126,7 @@ class Result:
     at_best: dict  # {target: (mean, se)} of the map at the answer
     delta: dict  # {"mu_s" | "mu_k" | "joint": delta chi2 of its 68.27 %}
     dof: dict  # {"mu_s" | "mu_k": Welch-Satterthwaite degrees of freedom}
+    edge: str | None = None  # "map" when the answer itself lies on the map's edge (not the law's bounds)
 
     def delta_at(self, mu_s, mu_k):
         """chi2 - least chi2 at the grid point nearest (mu_s, mu_k) (inf off the map)."""
@@ -231,7 +237,23 @@ def solve(targets, surf):
                 cut[name, end] = where
     at_best = {a: (float(mean[best]), math.sqrt(var[best])) for a, (mean, var, _) in surf.pred.items()
                if np.isfinite(mean[best])}
-    return Result(ms, mk, chi2, field, surf, ranges, cut, at_best, delta, dof)
+    return Result(ms, mk, chi2, field, surf, ranges, cut, at_best, delta, dof, _answer_edge(surf, inside, best))
+
+
+def _answer_edge(surf, inside, best):
+    """"map" when a neighbour of the answer's grid point along mu_s or mu_k is off the map (its
+    extent or hull) rather than beyond the law's bounds: the least chi2 is then where the map
+    stops, and the answer may lie beyond it; None inside."""
+    for axis in (0, 1):
+        for step in (-1, 1):
+            j = list(best)
+            j[axis] += step
+            if not 0 <= j[axis] < inside.shape[axis]:
+                return "map"
+            s, k = surf.ms[j[0]], surf.mk[j[1]]
+            if not inside[tuple(j)] and s / 2 - 1e-9 <= k <= s + 1e-9:
+                return "map"
+    return None
 
 
 def _edge(surf, region, inside, axis, i, step):

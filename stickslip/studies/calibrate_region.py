@@ -39,7 +39,7 @@ def draw(r, targets, pts, rolling, path):
         line = ax.axvline if name == "mu_s" else ax.axhline
         for end, v in (("lo", lo), ("hi", hi)):
             line(v, color="C0", lw=0.6, ls=":" if (name, end) in r.cut else "-", alpha=0.7)
-    x = np.array([0.15, 0.85])
+    x = np.array([r.surf.ms.min() - 0.05, r.surf.ms.max() + 0.05])  # the law's bounds across the map
     ax.plot(x, x, color="0.5", lw=0.6)
     ax.plot(x, x / 2, color="0.5", lw=0.6)
     ax.set_xlabel("μs")

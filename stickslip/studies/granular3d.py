@@ -35,8 +35,9 @@ from ..kinds import heap3d, incline3d
 from ..scene import find, parse
 
 # Stock history: stick_slip with mu_k = mu_s and no tangential dashpot (a slip caps the force
-# at mu Fn: docs/law.md). The range DEM users work in; 0.65 fills the diagonal of the map.
-MUS = (0.2, 0.35, 0.5, 0.65, 0.8)
+# at mu Fn: docs/law.md). The range DEM users work in; 0.65 fills the diagonal of the map, and
+# 1.0 is the map's row beyond it (MAP_PAIRS).
+MUS = (0.2, 0.35, 0.5, 0.65, 0.8, 1.0)
 # Stick-slip (mu_s, mu_k): mu_s and 2 mu_k - mu_s vary independently, and both land on MUS
 # (2 mu_k - mu_s = 0.2, 0.5, 0.2, 0.35): each prediction is a measured history point.
 PAIRS = ((0.8, 0.5), (0.8, 0.65), (0.5, 0.35), (0.5, 0.425))
@@ -44,10 +45,15 @@ PAIRS = ((0.8, 0.5), (0.8, 0.65), (0.5, 0.35), (0.5, 0.425))
 # mu_s 0.2-0.8, mu_s / 2 <= mu_k <= mu_s, in rows of mu_s = 0.2, 0.35, 0.5, 0.65, 0.8: every row
 # has a point on the lower edge mu_k = mu_s / 2 (the hull is the whole triangle, so that an
 # answer for a target inside the map is not cut by the map's edge) and one half way up
-# (0.15, 0.26, 0.49) or PAIRS' two; history is the diagonal.
+# (0.15, 0.26, 0.49) or PAIRS' two; history is the diagonal. And a row beyond the triangle, mu_s =
+# 1.0 (0.5, 0.75), so that an answer for a target near mu_s = 0.8 is not stopped where the map
+# stops (above mu_s ~ 0.5 the angles hardly move: issue 51's round trip). A row at mu_s = 0.1
+# was measured and left out: the angles curve so steeply below 0.2 that the linear map across
+# 0.1-0.35 errs by 1.4 deg on theta_start, and that error, taken as the same everywhere, widened
+# every answer's range (docs/granular-3d.md).
 MAP_PAIRS = PAIRS + ((0.2, 0.1), (0.35, 0.175), (0.5, 0.25), (0.65, 0.325), (0.8, 0.4),
-                     (0.2, 0.15), (0.35, 0.26), (0.65, 0.49))
-# The round trip of calibrate (granular3d_coverage.py): pairs that are not map points, spread
+                     (0.2, 0.15), (0.35, 0.26), (0.65, 0.49), (1.0, 0.5), (1.0, 0.75))
+# The round trip of calibrate (granular3d_calibration.py): pairs that are not map points, spread
 # over the triangle (two a row of mu_s = 0.27, 0.43, 0.57, 0.73, one low and one high, and the
 # pair of issue 51, (0.65, 0.45)), run on fills the map never used, incline and heap.
 COVERAGE_PAIRS = ((0.27, 0.17), (0.27, 0.24), (0.43, 0.25), (0.43, 0.37), (0.57, 0.35), (0.57, 0.5),

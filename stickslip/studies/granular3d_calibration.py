@@ -15,7 +15,8 @@
   with the heap's, with the sheared layer's peak and steady tau/sigma and dilation);
 - coverage_summary.csv: per set of targets, how many ranges held the truth, against 68.27 %
   and its binomial spread sqrt(p (1 - p) / n), z = (held - n p) / sqrt(n p (1 - p)); a range cut
-  by the map's edge or the law's bound is a bound, not a standard error, and is counted apart.
+  by the map's edge or the law's bound is a bound, not a standard error, and is counted apart;
+  and how many answers lie on the map's edge (answer_edge: the least chi2 where the map stops).
 """
 from __future__ import annotations
 
@@ -33,8 +34,8 @@ P = calibrate_fit.COVER
 COLUMNS = ["targets", "mu_s", "mu_k", "fills", "theta_start", "theta_start_se", "theta_stop", "theta_stop_se",
            "theta_heap", "theta_heap_se", "shear_peak", "shear_peak_se", "shear_steady", "shear_steady_se", "shear_dilation",
            "shear_dilation_se", "answer_mu_s", "mu_s_lo", "mu_s_hi", "answer_mu_k", "mu_k_lo", "mu_k_hi",
-           "mu_s_held", "mu_k_held", "mu_s_cut", "mu_k_cut", "delta_chi2_true", "joint_held", "chi2", "interpolation",
-           "refused"]
+           "mu_s_held", "mu_k_held", "mu_s_cut", "mu_k_cut", "answer_edge", "delta_chi2_true", "joint_held", "chi2",
+           "interpolation", "refused"]
 
 
 def loo_table(pts):
@@ -96,7 +97,8 @@ def coverage(pts, method="auto", surf=None):
                          "mu_k_held": k0 - tol <= mu_k <= k1 + tol,
                          "mu_s_cut": " ".join(f"{e}: {w}" for (n, e), w in r.cut.items() if n == "mu_s"),
                          "mu_k_cut": " ".join(f"{e}: {w}" for (n, e), w in r.cut.items() if n == "mu_k"),
-                         "delta_chi2_true": delta, "joint_held": delta <= r.delta["joint"], "chi2": r.chi2,
+                         "answer_edge": r.edge or "", "delta_chi2_true": delta,
+                         "joint_held": delta <= r.delta["joint"], "chi2": r.chi2,
                          "refused": ""})
     return pd.DataFrame(rows, columns=COLUMNS)
 
@@ -107,6 +109,7 @@ def summary(cov):
     rows = []
     for targets, g in cov.groupby("targets", sort=False):
         answered = g[g.refused.fillna("") == ""]
+        on_edge = int((answered.answer_edge.fillna("") != "").sum())
         for what, held, cut in (("mu_s range", "mu_s_held", "mu_s_cut"), ("mu_k range", "mu_k_held", "mu_k_cut"),
                                 ("joint region", "joint_held", None)):
             for which, sel in (("all", answered),
@@ -116,7 +119,8 @@ def summary(cov):
                 sd = math.sqrt(P * (1 - P) / n) if n else math.nan
                 rows.append({"targets": targets, "statement": what, "ranges": which, "pairs": n, "held": k,
                              "share": k / n if n else math.nan, "expected": P, "binomial_sd": sd,
-                             "z": (k / n - P) / sd if n else math.nan, "refused": len(g) - len(answered)})
+                             "z": (k / n - P) / sd if n else math.nan, "refused": len(g) - len(answered),
+                             "answers_on_edge": on_edge})
     return pd.DataFrame(rows)
 
 
@@ -151,8 +155,9 @@ def markdown(tables):
                   f"Pairs off the map, on fills it never used ([coverage.csv](coverage.csv)); expected {P:.1%} ± the "
                   "binomial spread.", "",
                   _md(tables["coverage_summary.csv"], ["targets", "statement", "ranges", "pairs", "held", "share",
-                                                       "expected", "binomial_sd", "z", "refused"]),
+                                                       "expected", "binomial_sd", "z", "refused", "answers_on_edge"]),
                   _md(tables["coverage.csv"], ["targets", "mu_s", "mu_k", "answer_mu_s", "mu_s_lo", "mu_s_hi",
                                                "answer_mu_k", "mu_k_lo", "mu_k_hi", "mu_s_held", "mu_k_held",
-                                               "delta_chi2_true", "joint_held", "mu_s_cut", "mu_k_cut"], ".3f")]
+                                               "delta_chi2_true", "joint_held", "mu_s_cut", "mu_k_cut", "answer_edge"],
+                                               ".3f")]
     return "\n".join(lines)

@@ -72,8 +72,10 @@ def calibration_map(out, pts):
             if np.isfinite(p[f"{angle}_mean"]):
                 ax.annotate(f"{p[f'{angle}_mean']:.1f}", (p.mu_s, p.mu_k), textcoords="offset points",
                             xytext=(6, -10), fontsize=8)
-        ax.plot([0.15, 0.85], [0.15, 0.85], color="0.7", lw=0.5)
-        ax.plot([0.15, 0.85], [0.075, 0.425], color="0.85", lw=0.5)  # mu_k = mu_s / 2, the law's lower bound
+        x = np.array([sel.mu_s.min() - 0.05, sel.mu_s.max() + 0.05])
+        ax.plot(x, x, color="0.7", lw=0.5)
+        ax.plot(x, x / 2, color="0.85", lw=0.5)  # mu_k = mu_s / 2, the law's lower bound
+        ax.set_xlim(x[0], x[1] + 0.1)  # room for the labels of the last row
         ax.set_xlabel("μs")
         ax.set_ylabel("μk")
         ax.set_title(f"{LABEL[angle]} (deg), rolling {r:g}, paper's ν_s")

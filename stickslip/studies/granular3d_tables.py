@@ -129,12 +129,15 @@ def curve(pts, angle, rolling, mu):
 
 def effective_mu(pts, angle, rolling, value):
     """The mu at which stock history's curve of `angle` reaches `value` (linear between the
-    measured mus), or nan where the curve is not monotonic or does not reach it."""
+    measured mus), or nan where the curve reaches it more than once (it levels off above mu ~
+    0.5, where the fills' spread can make it dip) or not at all."""
     h = history(_sweep(pts, KIND[angle], rolling))
     y, x = h[f"{angle}_mean"].to_numpy(float), h["mu_s"].to_numpy(float)
-    if len(y) < 2 or not np.all(np.diff(y) > 0) or not y[0] <= value <= y[-1]:
+    hits = [i for i in range(len(y) - 1) if min(y[i], y[i + 1]) <= value <= max(y[i], y[i + 1]) and y[i] != y[i + 1]]
+    if len(hits) != 1:
         return math.nan
-    return float(np.interp(value, y, x))
+    i = hits[0]
+    return float(x[i] + (value - y[i]) / (y[i + 1] - y[i]) * (x[i + 1] - x[i]))
 
 
 def _z(a, sa, b, sb):
