@@ -55,9 +55,11 @@ MAP_PAIRS = PAIRS + ((0.2, 0.1), (0.35, 0.175), (0.5, 0.25), (0.65, 0.325), (0.8
                      (0.2, 0.15), (0.35, 0.26), (0.65, 0.49), (1.0, 0.5), (1.0, 0.75))
 # The round trip of calibrate (granular3d_calibration.py): pairs that are not map points, spread
 # over the triangle (two a row of mu_s = 0.27, 0.43, 0.57, 0.73, one low and one high, and the
-# pair of issue 51, (0.65, 0.45)), run on fills the map never used, incline and heap.
+# pair of issue 51, (0.65, 0.45); then six more between them, for a tighter count), run on fills
+# the map never used, incline, heap and sheared layer.
 COVERAGE_PAIRS = ((0.27, 0.17), (0.27, 0.24), (0.43, 0.25), (0.43, 0.37), (0.57, 0.35), (0.57, 0.5),
-                  (0.65, 0.45), (0.73, 0.45), (0.73, 0.64))
+                  (0.65, 0.45), (0.73, 0.45), (0.73, 0.64),
+                  (0.3, 0.2), (0.4, 0.3), (0.47, 0.3), (0.6, 0.4), (0.7, 0.55), (0.77, 0.5))
 COVERAGE_FILLS = (11, 12, 13)
 # The sheared layer (cases/shear3d.toml, kind shear3d): a measurement that might tell mu_s from
 # mu_k. Its sensitivity to mu_s - mu_k at fixed mu_k on two lines, mu_k = 0.2 (where the bulk
