@@ -248,10 +248,7 @@ def _answer_edge(surf, inside, best):
         for step in (-1, 1):
             j = list(best)
             j[axis] += step
-            if not 0 <= j[axis] < inside.shape[axis]:
-                return "map"
-            s, k = surf.ms[j[0]], surf.mk[j[1]]
-            if not inside[tuple(j)] and s / 2 - 1e-9 <= k <= s + 1e-9:
+            if _beyond(surf, inside, *j) == "map":
                 return "map"
     return None
 
@@ -261,13 +258,20 @@ def _edge(surf, region, inside, axis, i, step):
     (the map's hull or extent), the law's bound ("mu_k = mu_s", "mu_k = mu_s / 2"), or None
     (the region closes inside)."""
     line = region[i] if axis == 0 else region[:, i]
-    n = len(surf.ms) if axis == 0 else len(surf.mk)
     for j in np.nonzero(line)[0]:
-        s_i, k_i = (i + step, j) if axis == 0 else (j, i + step)
-        if not 0 <= (s_i if axis == 0 else k_i) < n:
-            return "map"
-        if inside[s_i, k_i]:
-            continue
-        s, k = surf.ms[s_i], surf.mk[k_i]
-        return "mu_k = mu_s" if k > s + 1e-9 else "mu_k = mu_s / 2" if k < s / 2 - 1e-9 else "map"
+        where = _beyond(surf, inside, *((i + step, j) if axis == 0 else (j, i + step)))
+        if where:
+            return where
     return None
+
+
+def _beyond(surf, inside, s_i, k_i):
+    """What lies at grid point (s_i, k_i), a neighbour of a point on the map: None (the map),
+    "map" (off the grid, or outside the map's hull within the law's triangle), or the law's
+    bound it is beyond ("mu_k = mu_s", "mu_k = mu_s / 2")."""
+    if not (0 <= s_i < len(surf.ms) and 0 <= k_i < len(surf.mk)):
+        return "map"
+    if inside[s_i, k_i]:
+        return None
+    s, k = surf.ms[s_i], surf.mk[k_i]
+    return "mu_k = mu_s" if k > s + 1e-9 else "mu_k = mu_s / 2" if k < s / 2 - 1e-9 else "map"

@@ -48,9 +48,9 @@ PAIRS = ((0.8, 0.5), (0.8, 0.65), (0.5, 0.35), (0.5, 0.425))
 # (0.15, 0.26, 0.49) or PAIRS' two; history is the diagonal. And a row beyond the triangle, mu_s =
 # 1.0 (0.5, 0.75), so that an answer for a target near mu_s = 0.8 is not stopped where the map
 # stops (above mu_s ~ 0.5 the angles hardly move: issue 51's round trip). A row at mu_s = 0.1
-# was measured and left out: the angles curve so steeply below 0.2 that the linear map across
-# 0.1-0.35 errs by 1.4 deg on theta_start, and that error, taken as the same everywhere, widened
-# every answer's range (docs/granular-3d.md).
+# was measured and left out: the angles curve so steeply below 0.2 that it raised the linear
+# map's own error (leave-one-out) on theta_start from 0.60 to 1.38 deg, and that error, taken as
+# the same everywhere, widened every answer's range (docs/granular-3d.md).
 MAP_PAIRS = PAIRS + ((0.2, 0.1), (0.35, 0.175), (0.5, 0.25), (0.65, 0.325), (0.8, 0.4),
                      (0.2, 0.15), (0.35, 0.26), (0.65, 0.49), (1.0, 0.5), (1.0, 0.75))
 # The round trip of calibrate (granular3d_calibration.py): pairs that are not map points, spread
