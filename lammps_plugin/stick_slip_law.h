@@ -1,10 +1,11 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later
    stickslip: the stick-slip tangential contact law of Khellaf & Mansouri (2024) on LAMMPS.
 
-   This file is the only place the law lives on LAMMPS (the pair style and the walls call
-   it); it follows docs/law.md step by step, with the branch order and constants of
-   pyref/laws.py and liggghts_plugin/tangential_model_stick_slip.h. The exact slip timing's
-   engine-independent part (E1-E7) is exact_slip_timing.h.
+   The styles' part of the law (the pair style and the walls call it): the settings, the
+   spring's turn and the trial force as stock gran/hooke/history computes them, and stock's
+   rescale for reset total; the rest of the law (the slip test, eq. 8's reset to Fmin, exact
+   timing E0-E7, the energy) is the engine-free core, granular/stick_slip_core.h, that the
+   granular sub-model and the LIGGGHTS plugin share.
 
    With the default settings (reset total, slip_timing step, history_rotation project,
    damping mass, lever_arm radius) and mu_k = mu_s the arithmetic is stock
@@ -14,7 +15,7 @@
 #ifndef STICKSLIP_LAMMPS_LAW_H
 #define STICKSLIP_LAMMPS_LAW_H
 
-#include "exact_slip_timing.h"
+#include "stick_slip_core.h"
 
 #include "error.h"
 #include "lammps.h"
@@ -143,69 +144,9 @@ inline Coeffs make_coeffs(double kt, double mu_s, double mu_k)
   Coeffs c;
   c.kt = kt;
   c.mu_s = mu_s;
-  c.kin = 2.0 * mu_k - mu_s;
+  c.kin = LAMMPS_NS::StickSlipCore::kinetic(mu_s, mu_k);
   c.ratio = mu_s > 0.0 ? c.kin / mu_s : 1.0;
   return c;
-}
-
-/* exact_step's general case (E1-E7 through exact_slips). Out of line, and called on copies
-   of its vectors: an address taken on exact_step's path would keep V_s, F0 and the force in
-   memory for every contact, and the compiler would keep products it shares with the
-   sticking path (nu_s V_s) on the stack. limit = T = mu_s |Fn|, fmin = Fmin (exact_step's);
-   F: out, the force applied; D: out, the spring. */
-__attribute__((noinline)) inline void exact_general(const Settings &s, const Coeffs &c, double limit, double fmin,
-                                                    const double *vtr, double nu_s, double dt, const double *F0,
-                                                    double *F, double *D)
-{
-  const double kt = c.kt;
-  // E6 applies when nothing is added at the reset (reset total, or no dashpot)
-  const bool flow_law = c.ratio == 1.0 && (s.reset_total || nu_s == 0.0);
-  double applied[3], trial[3], stick;
-  stickslip::exact_slips(F0, vtr, limit, fmin, c.ratio, kt, nu_s, dt, s.reset_total, flow_law, applied, trial,
-                         stick);
-  // the spring at the end holds the trial force less the dashpot (eq. 5)
-  for (int k = 0; k < 3; k++) {
-    F[k] = applied[k];
-    D[k] = -(trial[k] + nu_s * vtr[k]) / kt;
-  }
-}
-
-/* Exact slip timing (docs/law.md E0-E7) for a step in which the trial force reached the
-   threshold at its start or end. F: in, the trial force at the end of the step (spring
-   after its increment, + dashpot); out, the force applied. D: out, the spring at the end.
-   (Inlined: in a flowing pile a third of the contact-steps slide (in.pour's chute), nearly
-   all through E4 at the start, whose few operations cost less than a call; the general
-   case, exact_general, is out of line.) */
-__attribute__((always_inline)) inline void exact_step(const Settings &s, const Coeffs &c, double fnabs,
-                                                        const double *vtr, double nu_s, double dt, double start2,
-                                                        const double *F0, double *F, double *D)
-{
-  const double kt = c.kt, limit = c.mu_s * fnabs, fmin = c.kin * fnabs;
-  const double vs2 = stickslip::dot3(vtr, vtr);
-  if (start2 >= limit * limit && limit > 0.0 && !s.reset_total && nu_s * nu_s * vs2 > 0.0 &&
-      (fmin * fmin + nu_s * nu_s * vs2 - limit * limit) * std::sqrt(start2) -
-              2.0 * fmin * nu_s * stickslip::dot3(F0, vtr) >=
-          0.0) {
-    // E4 at the step's start, the common slipping case in dense flows: the force is at or
-    // above T at theta = 0 and after the slip the dashpot alone keeps it there,
-    // |Fmin t0 + nu_s |V_s| u| >= T with t0 = F0/|F0|, u = -V_s/|V_s| (expanded: one square
-    // root, no division). The contact slides at Fmin u all step; the spring holds the trial
-    // force (Fmin + nu_s |V_s|) u less the dashpot, i.e. Fmin u (eq. 5).
-    const double a = fmin / std::sqrt(vs2), akt = a / kt;
-    for (int k = 0; k < 3; k++) {
-      F[k] = -a * vtr[k];
-      D[k] = akt * vtr[k];
-    }
-    return;
-  }
-  // the general case: on copies (exact_general)
-  const double v[3] = {vtr[0], vtr[1], vtr[2]}, f0[3] = {F0[0], F0[1], F0[2]};
-  double f[3], d[3];
-  exact_general(s, c, limit, fmin, v, nu_s, dt, f0, f, d);
-  for (int k = 0; k < 3; k++) {
-    F[k] = f[k];
-    D[k] = d[k];
-  }
 }
 
 /* Which of the law's branches the tangential force tests at run time. RuntimeMode reads the
@@ -315,18 +256,12 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
   const double fnabs = std::fabs(ccel_r);
   const double limit = c.mu_s * fnabs;
   const double sum = fs[0] * fs[0] + fs[1] * fs[1] + fs[2] * fs[2];
-  bool slipped = sum >= limit * limit;
+  bool slipped = LAMMPS_NS::StickSlipCore::slips(sum, limit * limit);
   if (Mode::exact(s)) {
-    // E0: |F| moves on a line during the step and is convex in time, so the step has no
-    // slip iff it is below the threshold at both ends; then it is exactly the step mode.
-    // An evaluation without update (set-up) is a step of length 0.
-    const double h = update ? dt : 0.0;
-    const double ktdt = kt * h;
-    // the trial force at the step's start: the spring before the increment V_s dt
-    const double F0[3] = {fs[0] + ktdt * vtr[0], fs[1] + ktdt * vtr[1], fs[2] + ktdt * vtr[2]};
-    const double start2 = stickslip::dot3(F0, F0);
-    slipped = slipped || start2 >= limit * limit;
-    if (slipped) exact_step(s, c, fnabs, vtr, nu_s, h, start2, F0, fs, D);
+    // E0-E7 (stick_slip_core.h); an evaluation without update (set-up) is a step of length 0
+    double stick;
+    slipped = LAMMPS_NS::StickSlipCore::exact_step(slipped, fs, D, vtr, kt, nu_s, update ? dt : 0.0, limit,
+                                                   c.kin * fnabs, c.ratio, s.reset_total, stick);
   } else if (slipped) {
     // (stock's |D| after the increment, tested only here, at a slip)
     if (Mode::project(s) && incremented[0] * incremented[0] + incremented[1] * incremented[1] +
@@ -339,7 +274,8 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) |Fn| along the trial force
       const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;
       if (s.reset_total) {
-        // eq. 8, reset total: spring + dashpot = Fmin (stock's rescale of the shear)
+        // reset total: spring + dashpot = Fmin in stock's rescale of the shear, so that with
+        // mu_k = mu_s the renamed styles are stock bit for bit
         for (int k = 0; k < 3; k++) {
           const double dv = nu_s * vtr[k] / kt;
           D[k] = ratio * (D[k] + dv) - dv;
@@ -349,8 +285,7 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
       fs[1] *= ratio;
       fs[2] *= ratio;
       // eq. 8, reset spring (the paper): Ks |D| = Fmin
-      if (!s.reset_total)
-        for (int k = 0; k < 3; k++) D[k] = -fs[k] / kt;
+      if (!s.reset_total) LAMMPS_NS::StickSlipCore::reset(fs, nullptr, kt, false, D);
     }
   }
 
@@ -360,7 +295,7 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
       // the increase of the spring energy Ks |D|^2/2
       const double before = hist[0] * hist[0] + hist[1] * hist[1] + hist[2] * hist[2];
       const double after = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
-      hist[HIST_WORK] += -stickslip::dot3(fs, vtr) * dt - 0.5 * kt * (after - before);
+      hist[HIST_WORK] += LAMMPS_NS::StickSlipCore::dissipated(fs, vtr, dt, kt, before, after);
       if (slipped) hist[HIST_NSLIP] += 1.0;
     }
     hist[HIST_FN] = ccel_r;

@@ -26,14 +26,8 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 #include "neighbor.h"
 #include "atom.h"
 #include "fix_property_atom.h"
-// the plugin's analysis build counts the law's paths; otherwise (and in LIGGGHTS' own
-// build, which has no stick_slip_path_counts.h) the counts compile to nothing
-#ifdef STICK_SLIP_PATH_COUNTS
-#include "stick_slip_path_counts.h"
-#else
-#define STICK_SLIP_COUNTING(on) ((void)0)
-#define STICK_SLIP_COUNT(path) ((void)0)
-#endif
+// the law's engine-free core, shared with LAMMPS (lammps_plugin/granular/)
+#include "stick_slip_core.h"
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -91,140 +85,11 @@ namespace StickSlip {
     return mu_k;
   }
 
-  // Exact slip timing (docs/law.md "Exact slip timing", E1-E7; pyref/laws.py _exact_slips is
-  // the reference, same branch order and constants; for speed, E4 at the step's start is
-  // tested first, by the caller, surfacesIntersect). Slips are followed one by one until the
-  // force direction has settled along -V_s (its part across -V_s below SETTLED * mu_s Fn, so
-  // that it changes the slip level by less than round-off) or MAX_EXPLICIT_SLIPS slips have
-  // been followed in the step; the remaining slips of the step then have a closed form.
-  static const double SETTLED = 1e-8;
   // internal on/off settings behind the keywords history_rotation and history_on_separation
   static const char * const ROTATION_PROJECT = "stick_slip_history_project";
   static const char * const SEPARATION_KEEP = "stick_slip_keep_separated";
-  static const int MAX_EXPLICIT_SLIPS = 100;
-
-  inline double dot(const double * a, const double * b) { return a[0]*b[0] + a[1]*b[1] + a[2]*b[2]; }
-
-  /* E6: mu_k = mu_s, the force stays on |F| = T and turns towards u. With phi the angle
-     between F and u, tan(phi/2) falls as exp(-rate*theta/T); over the rest of the step by
-     exp(-k_rest). F is replaced by the force at the end of the step. */
-  inline void plastic_flow(double * F, const double * u, double k_rest, double T)
-  {
-    const double f = dot(F, u);
-    double q[3];
-    FOR_XYZ(k) q[k] = F[k] - f * u[k];
-    const double qn = std::sqrt(dot(q, q));
-    const double s = qn / (T + f) * std::exp(-k_rest);  // tan(phi/2) at the end (f >= 0 here)
-    const double c = (1.0 - s * s) / (1.0 + s * s), sn = 2.0 * s / (1.0 + s * s);
-    FOR_XYZ(k) F[k] = (T * c) * u[k] + (T * sn) * (qn > 0.0 ? q[k] / qn : 0.0);
-  }
-
-  /* One step of a contact in which at least one slip happens (eqs. 5, 7, 8 integrated over
-     the step). V_s and Fn are constant over the step, so the trial force F = -Ks D - nu_s V_s
-     moves along u = -V_s/|V_s| at `rate` = Ks |V_s| dt per unit of step fraction theta.
-     In: F0, the trial force at theta = 0 (D turned, not yet incremented). Out: the force at
-     the end of the step (the one applied, as in a step without slip), the trial force at
-     the end (spring + dashpot) and the share of the step spent sticking. */
-  // (kept out of line: it runs only in steps that slip, and inlined it would crowd the
-  // common sticking step's code)
-  inline __attribute__((noinline)) void exact_slips(const double * F0, const double * vs, double T, double fmin, double r,
-                          double kt, double gammat, double dt, bool reset_total, bool flow_law,
-                          double * applied, double * trial, double & stick)
-  {
-    const double speed = std::sqrt(dot(vs, vs));
-    double u[3];
-    FOR_XYZ(k) u[k] = speed > 0.0 ? -vs[k] / speed : 0.0;
-    const double rate = kt * speed * dt;
-    // after a slip the trial force restarts from Fmin t + kept u (E3): the spring holds Fmin
-    // and the dashpot adds nu_s |V_s| (default reset), or both hold Fmin (slip_reset_total)
-    const double kept = reset_total ? 0.0 : gammat * speed;
-    stick = 0.0;
-    if (!(T > 0.0)) {  // E1: no normal force, no friction; the spring keeps what the reset leaves
-      STICK_SLIP_COUNT(GEN_E1);
-      FOR_XYZ(k) { applied[k] = 0.0; trial[k] = kept * u[k]; }
-      return;
-    }
-    double F[3] = { F0[0], F0[1], F0[2] };
-    double theta = 0.0;
-    for (int slips = 0; ; ) {
-      // E2: the next slip, where |F + rate dtheta u| reaches T (the larger root); before the
-      // step's first slip the force may already be at or above T (Fn fell): slip at once
-      const double f = dot(F, u), F2 = dot(F, F);
-      double dtheta;
-      if (slips == 0 && F2 >= T * T) dtheta = 0.0;
-      else {
-        const double gap = std::max(std::sqrt(std::max(T * T - (F2 - f * f), 0.0)) - f, 0.0);
-        dtheta = rate > 0.0 ? gap / rate : INFINITY;
-      }
-      if (!(theta + dtheta <= 1.0)) {  // sticks to the end of the step
-        STICK_SLIP_COUNT(GEN_STICK_TO_END);
-        const double rest = 1.0 - theta;
-        FOR_XYZ(k) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];
-        stick += rest;
-        return;
-      }
-      double hit[3];
-      FOR_XYZ(k) hit[k] = F[k] + (rate * dtheta) * u[k];
-      stick += dtheta;
-      theta += dtheta;
-      // E3: the slip; the force drops to Fmin along its direction t, the spring is reset (eq. 8)
-      const double hn = std::sqrt(dot(hit, hit));
-      double t[3];
-      FOR_XYZ(k) t[k] = hit[k] / hn;
-      slips++;
-      STICK_SLIP_COUNT(GEN_SLIP);
-      FOR_XYZ(k) F[k] = fmin * t[k] + kept * u[k];
-      const double rest = 1.0 - theta;
-      // E4: the restarted force is at or above T again: slips follow without end and turn t
-      // onto u, the contact slides at Fmin u for the rest of the step
-      if (kept > 0.0 && dot(F, F) >= T * T) {
-        STICK_SLIP_COUNT(GEN_E4);
-        FOR_XYZ(k) { trial[k] = (fmin + kept) * u[k]; applied[k] = fmin * u[k]; }
-        return;
-      }
-      if (rate == 0.0) {  // E5: nothing moves, the force stays where the slip left it
-        STICK_SLIP_COUNT(GEN_E5);
-        FOR_XYZ(k) applied[k] = trial[k] = F[k];
-        stick += rest;
-        return;
-      }
-      const double along = dot(t, u);
-      // (t.u = 0 too: |F + rate theta u| = T sqrt(1 + (rate theta/T)^2) rises at once, so the
-      // force flows from phi = 90 degrees; only t.u < 0 unloads into the cone and sticks)
-      if (flow_law && along >= 0.0) {  // E6: plastic flow on |F| = T
-        STICK_SLIP_COUNT(GEN_E6);
-        plastic_flow(F, u, rate * rest / T, T);
-        FOR_XYZ(k) applied[k] = trial[k] = F[k];
-        return;
-      }
-      // E7: settled along u (or followed MAX_EXPLICIT_SLIPS times): the remaining slips of
-      // the step repeat one cycle (Fmin + kept) u -> T u, of length L in theta; the part q of
-      // the force across u shrinks by r at each slip
-      const double fu = dot(F, u);
-      double q[3];
-      FOR_XYZ(k) q[k] = F[k] - fu * u[k];
-      if ((std::sqrt(dot(q, q)) <= SETTLED * T && along > 0.0) || slips >= MAX_EXPLICIT_SLIPS) {
-        STICK_SLIP_COUNT(GEN_E7);
-        const double low = fmin + kept;
-        const double L = (T - low) / rate;
-        if (!(L > 0.0)) {  // restarts at T: slides, as E4
-          FOR_XYZ(k) { trial[k] = low * u[k]; applied[k] = fmin * u[k]; }
-          return;
-        }
-        const double n = std::floor(rest / L);
-        const double part = rest - n * L;
-        const double shrink = n == 0.0 ? 1.0 : std::pow(r, n);  // (no whole cycle left: the common case)
-        FOR_XYZ(k) applied[k] = trial[k] = (low + rate * part) * u[k] + shrink * q[k];
-        stick += rest;
-        return;
-      }
-    }
-  }
 }
 
-#ifdef STICK_SLIP_CONTROL_STOCK
-#include "control_stock_history.h"  // the benchmark's control (issue 32), not the law
-#else
 template<>
 class TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase
 {
@@ -365,11 +230,6 @@ public:
     const double fn = std::fabs(sidata.Fn);
     const bool update_history = PLAIN || (sidata.computeflag && sidata.shearupdate);
     const bool energy = !PLAIN && update_history && energy_books;
-    STICK_SLIP_COUNTING(true);
-    if (!update_history) STICK_SLIP_COUNT(CALL_NO_UPDATE);
-    else if (sidata.is_wall) STICK_SLIP_COUNT(CALL_WALL);
-    else STICK_SLIP_COUNT(CALL_PAIR);
-    STICK_SLIP_COUNTING(update_history);  // the paths below: evaluations that update the history
 
     double * const hist = &sidata.contact_history[history_offset];
     // a pair that did not touch at the previous pass is a new contact (see postSettings).
@@ -379,25 +239,21 @@ public:
     if (update_history && stamp_offset >= 0)
       fresh = sidata.contact_history[stamp_offset] != touched_last;
     double D[3] = { hist[0], hist[1], hist[2] };
-    if (fresh) {
-      STICK_SLIP_COUNT(STAMP_FRESH);
-      D[0] = D[1] = D[2] = 0.0;
-    }
-    const double spring_before = energy ? 0.5 * kt * StickSlip::dot(D, D) : 0.0;
+    if (fresh) D[0] = D[1] = D[2] = 0.0;
+    const double before2 = energy ? StickSlipCore::dot(D, D) : 0.0;  // |D|^2 at the step's start
     // a re-evaluation without history update (run setup, computes) is a step of length 0
     const double dt = update_history ? update->dt : 0.0;
     if (update_history) {
       if (project) {
         // stock history: increment, then project onto the current tangent plane
         FOR_XYZ(k) D[k] += vs[k] * dt;
-        const double dn = StickSlip::dot(D, en);
+        const double dn = StickSlipCore::dot(D, en);
         FOR_XYZ(k) D[k] -= dn * en[k];
         // (exact timing: the step starts from D - V_s dt, the increment projected with D)
       } else {
         // 3D form: turn D into the current tangent plane, keeping its length (docs/law.md
         // step 3): D <- (D - dn n) * sqrt(old2/new2) with new2 = old2 (1 - x), x = dn^2/old2
         const double dn = D[0]*en[0] + D[1]*en[1] + D[2]*en[2];
-        if (dn == 0.0) STICK_SLIP_COUNT(TURN_NONE);
         if (dn != 0.0) {
           const double old2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
           const double x = dn * dn / old2;  // sin^2 of the angle between D and the plane
@@ -406,8 +262,6 @@ public:
           // (1 - x)^(-1/2), whose first dropped term, 5x^3/16 < 4e-19, is below round-off;
           // it spares the square root on the path every contact takes (1-2 % of a step, measured)
           double scale = 1.0 + x * (0.5 + 0.375 * x);
-          if (x < 1e-6) STICK_SLIP_COUNT(TURN_SERIES);
-          else STICK_SLIP_COUNT(TURN_SQRT);
           if (!(x < 1e-6)) {
             const double new2 = D[0]*D[0] + D[1]*D[1] + D[2]*D[2];
             scale = new2 > 0.0 ? std::sqrt(old2 / new2) : 1.0;
@@ -426,71 +280,23 @@ public:
     const double limit = ms * fn;
     // static threshold reached (Fn = 0 always slips); squared, so that a sticking step
     // (the common case) needs no square root
-    bool slip = mag2 >= limit * limit;
+    bool slip = StickSlipCore::slips(mag2, limit * limit);
     double stick = slip ? 0.0 : 1.0;  // share of the step spent sticking (energy: the dashpot's share)
     if (exact) {
-      // E0: |F| moves on a line during the step and is convex in time, so the step has no
-      // slip iff it is below the threshold at both ends; then it is exactly the step above.
-      // the trial force at the step's start: the spring before the increment V_s dt
-      const double ktdt = kt * dt;
-      const double F00 = F[0] + ktdt * vs[0], F01 = F[1] + ktdt * vs[1], F02 = F[2] + ktdt * vs[2];
-      const double start2 = F00*F00 + F01*F01 + F02*F02;
-      const bool start_over = start2 >= limit * limit;
-      slip = slip || start_over;
-      if (start_over) STICK_SLIP_COUNT(EXACT_START_OVER);
-      if (!slip) STICK_SLIP_COUNT(EXACT_NO_SLIP);
-      if (slip) {
-        const double mk = mu_k[sidata.itype][sidata.jtype];
-        const double fmin = (2.0 * mk - ms) * fn;
-        const double vs2 = StickSlip::dot(vs, vs);
-        if (start_over && limit > 0.0 && !reset_total && gammat * gammat * vs2 > 0.0 &&
-            (fmin * fmin + gammat * gammat * vs2 - limit * limit) * std::sqrt(start2)
-              - 2.0 * fmin * gammat * (F00 * vs[0] + F01 * vs[1] + F02 * vs[2]) >= 0.0) {
-          // E4 at the step's start, the common slipping case in dense flows (over 90 % of them
-          // in the benchmark pour), tested here first: the force is at or above T at theta = 0
-          // and after the slip the dashpot alone keeps it there, |Fmin t0 + nu_s |V_s| u| >= T
-          // with t0 = F0/|F0|, u = -V_s/|V_s| (expanded: one square root, no division). The
-          // contact slides at Fmin u all step; the spring holds the trial force (Fmin +
-          // nu_s |V_s|) u less the dashpot, i.e. Fmin u (eq. 5).
-          STICK_SLIP_COUNT(EXACT_E4_START);
-          const double c = fmin / std::sqrt(vs2), ck = c / kt;
-          FOR_XYZ(k) {
-            F[k] = -c * vs[k];
-            D[k] = ck * vs[k];
-          }
-          stick = 0.0;
-        } else {
-          // (exact_slips works on copies: an array whose address is passed on lives in
-          // memory for the whole function, and F, vs are on the path every contact takes)
-          STICK_SLIP_COUNT(EXACT_GENERAL);
-          // (F0 recomputed: F00, F01, F02 stay in registers on the common path)
-          const double F0[3] = { F[0] + ktdt * vs[0], F[1] + ktdt * vs[1], F[2] + ktdt * vs[2] };
-          const double v[3] = { vs[0], vs[1], vs[2] };
-          const double r = (2.0 * mk - ms) / ms;  // Fmin/T, exactly 1 iff mu_k = mu_s
-          // E6 applies when nothing is added at the reset (slip_reset_total, or no dashpot)
-          const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);
-          double applied[3], trial[3], stuck;
-          StickSlip::exact_slips(F0, v, limit, fmin, r, kt, gammat, dt, reset_total, flow_law, applied, trial, stuck);
-          stick = stuck;
-          // the spring at the end holds the trial force less the dashpot (eq. 5)
-          FOR_XYZ(k) {
-            F[k] = applied[k];
-            D[k] = -(trial[k] + gammat * vs[k]) / kt;
-          }
-        }
-      }
+      // E0-E7 (stick_slip_core.h)
+      const double kin = StickSlipCore::kinetic(ms, mu_k[sidata.itype][sidata.jtype]);
+      slip = StickSlipCore::exact_step(slip, F, D, vs, kt, gammat, dt, limit, kin * fn, kin / ms, reset_total,
+                                       stick);
     } else if (slip) {
-      STICK_SLIP_COUNT(STEP_SLIP);
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) Fn along the trial force
-      const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;
+      const double fmin = StickSlipCore::kinetic(ms, mu_k[sidata.itype][sidata.jtype]) * fn;
       const double scale = mag2 > 0.0 ? fmin / std::sqrt(mag2) : 0.0;
       FOR_XYZ(k) F[k] *= scale;
       // eq. 8: reset the spring so that it carries Fmin (or spring + dashpot do)
-      FOR_XYZ(k)
-        D[k] = reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;
+      const double fdamp[3] = { -gammat * vs[0], -gammat * vs[1], -gammat * vs[2] };
+      StickSlipCore::reset(F, fdamp, kt, reset_total, D);
     }
 
-    if (!exact && !slip) STICK_SLIP_COUNT(STEP_STICK);
     if (update_history) {
       FOR_XYZ(k) hist[k] = D[k];
       if (stamp_offset >= 0) sidata.contact_history[stamp_offset] = this_pass;
@@ -506,7 +312,7 @@ public:
     const double tor[3] = { en[1]*F[2] - en[2]*F[1], en[2]*F[0] - en[0]*F[2], en[0]*F[1] - en[1]*F[0] };
     if (energy) {
       const double Fc[3] = { F[0], F[1], F[2] }, Dc[3] = { D[0], D[1], D[2] }, vc[3] = { vs[0], vs[1], vs[2] };
-      account_energy(sidata, Fc, Dc, vc, kt, gammat, spring_before, stick);  // (copies: as exact_slips)
+      account_energy(sidata, Fc, Dc, vc, kt, gammat, before2, stick);  // (on copies: see StickSlipCore::exact_step)
     }
     if (sidata.is_wall) {
       const double a = sidata.area_ratio;
@@ -533,12 +339,12 @@ public:
      the per-atom dissipated_energy property; the energy itself is added to that
      property's first value, "energy" (half to each grain of a pair). */
   __attribute__((noinline)) void account_energy(const SurfacesIntersectData & sidata, const double * F, const double * D,
-                             const double * vs, double kt, double gammat, double spring_before, double stick)
+                             const double * vs, double kt, double gammat, double before2, double stick)
   {
     const double dt = update->dt;
     const double a = sidata.is_wall ? sidata.area_ratio : 1.0;
-    const double total = (-StickSlip::dot(F, vs) * dt - (0.5 * kt * StickSlip::dot(D, D) - spring_before)) * a;
-    const double dashpot = gammat * StickSlip::dot(vs, vs) * dt * stick * a;
+    const double total = StickSlipCore::dissipated(F, vs, dt, kt, before2, StickSlipCore::dot(D, D)) * a;
+    const double dashpot = gammat * StickSlipCore::dot(vs, vs) * dt * stick * a;
     const double slips = total - dashpot;
     if (heating) {
       sidata.P_diss += total / dt;
@@ -615,7 +421,6 @@ public:
   }
   inline void endPass(SurfacesIntersectData &, ForceData &, ForceData &) {}
 };
-#endif  // STICK_SLIP_CONTROL_STOCK
 
 }
 }

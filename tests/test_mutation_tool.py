@@ -27,7 +27,7 @@ def test_every_mutant_is_found_in_its_engines_source(engine):
     eng = TOOL.ENGINES[engine]
     unfound = []
     for m in eng.mutants:
-        source = (ROOT / eng.source / (m.file or eng.law_file)).read_text()
+        source = (ROOT / (m.file or eng.law_file)).read_text()
         found = len(TOOL.pattern(m.find).findall(source))
         if found != m.count:
             unfound.append(f"{m.id}: found {found} times, expected {m.count}")
@@ -38,3 +38,18 @@ def test_every_mutant_is_found_in_its_engines_source(engine):
 def test_mutant_ids_are_unique(engine):
     ids = [m.id for m in TOOL.ENGINES[engine].mutants]
     assert len(ids) == len(set(ids))
+
+
+def test_every_engine_that_includes_the_core_runs_its_mutants():
+    """The law's core (lammps_plugin/granular/stick_slip_core.h) has one mutant list, and
+    every engine whose build includes the core runs all of it; the others (DEM-Engine's own
+    float copy) none of it."""
+    core = TOOL.CORE
+    for name, eng in TOOL.ENGINES.items():
+        includes = any(core.startswith(folder + "/") for folder in (eng.source, *eng.copies))
+        ids = {m.id for m in eng.mutants}
+        core_ids = {m.id for m in TOOL.CORE_MUTANTS}
+        assert (core_ids <= ids) if includes else not (core_ids & ids), name
+    for folder in ("liggghts_plugin", "lammps_plugin"):
+        text = "\n".join(p.read_text() for p in (ROOT / folder).rglob("*.h"))
+        assert '#include "stick_slip_core.h"' in text, folder

@@ -123,7 +123,7 @@ def test_one_version_in_pyproject_the_package_the_laws_the_header_citation_and_c
     assert deme.helper().__version__ == VERSION
     assert python_says("import sys", "sys.path.insert(0, 'yade_law')", "import stickslip_yade",
                        "print(stickslip_yade.__version__)") == VERSION
-    header = (ROOT / "lammps_plugin" / "granular" / "stickslip_version.h").read_text()
+    header = (ROOT / "lammps_plugin" / "stickslip_version.h").read_text()
     assert re.findall(r'^#define STICKSLIP_VERSION "(.*)"$', header, re.M) == [VERSION]
     assert f"## [{VERSION}]" in (ROOT / "CHANGELOG.md").read_text()
 

@@ -5,8 +5,9 @@ suite see it? (issue 31 item 5; the README's test section quotes the last result
 
     .venv/bin/python tools/mutate_cpp.py [--engine liggghts|lammps|deme] [--only ID ...] [--wide]
 
-For each mutant: copy the engine's source folder into build/mutants/<engine>/src (the
-repository's files are never touched), apply the mutant to the copy, rebuild in
+For each mutant: copy the engine's source folder, with the law's core beside it, into
+build/mutants/<engine>/src (the repository's layout; its files are never touched), apply the
+mutant to the copy, rebuild in
 build/mutants/<engine>/build, and run the engine's test selection with the adapter
 pointed at that build (STICKSLIP_LIGGGHTS_BUILD, STICKSLIP_LAMMPS_BUILD; DEM-Engine's force
 model: STICKSLIP_DEME_SHIM_BUILD, its CPU build for the tests). A mutant is found by the
@@ -22,10 +23,11 @@ build (3x quicker to compile than the project's; the same IEEE operations withou
 contraction, so the same numbers: the baseline must pass it first), the wide one on a
 Release build as ./run.sh setup makes it (the large scenes run 3-5x faster there).
 
-An engine is one entry in ENGINES: its source folder, the file the law lives in (a mutant
-may name another file of the folder), the environment variable its adapter reads, its
-test selections, its configure arguments, and its mutants (the same kinds, found in its
-own text).
+An engine is one entry in ENGINES: its source folder, the file its part of the law lives in
+(a mutant may name another file), the environment variable its adapter reads, its test
+selections, its configure arguments, and its mutants: its own (the same kinds, found in its
+own text) and the core's (CORE_MUTANTS, lammps_plugin/granular/stick_slip_core.h), which every
+engine that includes the core must kill. DEM-Engine's float force model is its own copy.
 """
 from __future__ import annotations
 
@@ -50,144 +52,142 @@ class Mutant:
     find: str  # the text to change (whitespace-insensitive)
     replace: str
     count: int = 1  # how many times `find` must occur (all are changed)
-    file: str = ""  # the file mutated, inside the engine's source ("": the engine's law_file)
+    file: str = ""  # the file mutated, a path in the repository ("": the engine's law_file)
 
 
 @dataclass(frozen=True)
 class Engine:
-    source: str  # folder copied and built
-    law_file: str  # the file mutated, inside `source`
+    source: str  # the folder built (a path in the repository)
+    law_file: str  # the file mutated when a mutant names none (a path in the repository)
     build_env: str  # the adapter's variable for the build folder
     fast: tuple  # pytest arguments: the selection every mutant runs
     wide: tuple  # the engine's default-suite tests, for mutants the fast one misses
     mutants: tuple
     cmake_args: tuple = ()  # configure arguments beyond the build type
     builder: object = None  # build(src, out, quick, cmake_args) for an engine built otherwise (None: cmake -S src)
+    copies: tuple = ("lammps_plugin/granular",)  # folders copied beside `source` (the law's core)
 
 
-def exact_path_mutants(file=""):
-    """Mutants of the exact timing's E6 and E7 paths, whose text both engines share."""
-    return (
-        Mutant("flow_not_at_right_angle", "E6 (plastic flow) left out at t.u = 0",
-               "if (flow_law && along >= 0.0)", "if (flow_law && along > 0.0)", file=file),
-        Mutant("flow_rest_inverted", "E6 (plastic flow) over the wrong share of the step",
-               "plastic_flow(F, u, rate * rest / T, T);", "plastic_flow(F, u, rate / rest / T, T);", file=file),
-        Mutant("max_slips_counted_twice", "exact timing's closed form (E7) after 50 slips, not 100",
-               "slips++;", "slips += 2;", file=file),
-        Mutant("periodic_across_sign", "E7's closed form with the part across u turned",
-               "+ shrink * q[k];", "- shrink * q[k];", file=file),
-        Mutant("slid_at_zero_cycle", "E7 with a cycle of length 0 taken as periodic",
-               "if (!(L > 0.0)) {", "if (!(L >= 0.0)) {", file=file),
-    )
+# The law's engine-free core, included by LIGGGHTS, LAMMPS 2021's styles and the LAMMPS
+# sub-model: one list, run on each of the three (`--engine`); each must kill every mutant.
+CORE = "lammps_plugin/granular/stick_slip_core.h"
+CORE_MUTANTS = (
+    Mutant("core_threshold_gt", "> for >= at the threshold",
+           "static bool slips(double force, double threshold) { return force >= threshold; }",
+           "static bool slips(double force, double threshold) { return force > threshold; }", file=CORE),
+    Mutant("core_fmin_0.3pct", "Fmin off by 0.3 %",
+           "static double kinetic(double mu_s, double mu_k) { return 2.0 * mu_k - mu_s; }",
+           "static double kinetic(double mu_s, double mu_k) { return (2.0 * mu_k - mu_s) * 1.003; }", file=CORE),
+    Mutant("core_reset_spring_sign", "sign error in the spring reset",
+           "const double back = -1.0 / ks;", "const double back = 1.0 / ks;", file=CORE),
+    Mutant("core_reset_total_sign", "sign error in the spring reset",
+           "(total ? F[i] - fdamp[i] : F[i]) * back;", "(total ? F[i] + fdamp[i] : F[i]) * back;", file=CORE),
+    Mutant("core_reset_total_ignored", "the reset rule `total` ignored",
+           "(total ? F[i] - fdamp[i] : F[i]) * back;", "F[i] * back;", file=CORE),
+    Mutant("core_work_spring_sign", "a wrong dissipated work",
+           "return -dot(F, vs) * dt - 0.5 * ks * (after2 - before2);",
+           "return -dot(F, vs) * dt + 0.5 * ks * (after2 - before2);", file=CORE),
+    Mutant("core_exact_start_sign", "sign error in the trial force at the step's start (exact timing)",
+           "const double F0[3] = {F[0] + ksdt * vs[0], F[1] + ksdt * vs[1], F[2] + ksdt * vs[2]};",
+           "const double F0[3] = {F[0] - ksdt * vs[0], F[1] - ksdt * vs[1], F[2] - ksdt * vs[2]};", file=CORE),
+    Mutant("core_exact_misses_slip_at_start", "exact timing that misses a slip inside the step",
+           "if (!(end_slips || start_slips)) return false;", "if (!end_slips) return false;", file=CORE),
+    Mutant("core_exact_e4_sign", "sign error in the spring reset",
+           "D[i] = aks * vs[i];", "D[i] = -aks * vs[i];", file=CORE),
+    Mutant("core_exact_e4_condition", "> for >= at the threshold",
+           "- 2.0 * fmin * nu_s * dot(F0, vs) >= 0.0", "- 2.0 * fmin * nu_s * dot(F0, vs) > 0.0", file=CORE),
+    Mutant("core_exact_end_sign", "sign error in the spring reset",
+           "D[i] = -(trial[i] + nu_s * vs[i]) / ks;", "D[i] = -(trial[i] - nu_s * vs[i]) / ks;", file=CORE),
+    Mutant("core_flow_ignores_reset_total", "the reset rule `total` ignored",
+           "ratio == 1.0 && (total || nu_s == 0.0)", "ratio == 1.0 && nu_s == 0.0", file=CORE),
+    Mutant("core_threshold_gt_exact_loop", "> for >= at the threshold",
+           "if (slips == 0 && F2 >= T * T)", "if (slips == 0 && F2 > T * T)", file=CORE),
+    Mutant("core_exact_misses_whole_cycles", "exact timing that misses a slip inside the step",
+           "const double n = std::floor(rest / L);", "const double n = 0.0;", file=CORE),
+    Mutant("core_exact_slip_late", "exact timing that misses a slip inside the step",
+           "dtheta = rate > 0.0 ? gap / rate : INFINITY;", "dtheta = rate > 0.0 ? 1.5 * gap / rate : INFINITY;",
+           file=CORE),
+    Mutant("core_reset_total_ignored_exact", "the reset rule `total` ignored",
+           "const double kept = reset_total ? 0.0 : nu_s * speed;", "const double kept = nu_s * speed;", file=CORE),
+    Mutant("core_flow_not_at_right_angle", "E6 (plastic flow) left out at t.u = 0",
+           "if (flow_law && along >= 0.0)", "if (flow_law && along > 0.0)", file=CORE),
+    Mutant("core_flow_rest_inverted", "E6 (plastic flow) over the wrong share of the step",
+           "plastic_flow(F, u, rate * rest / T, T);", "plastic_flow(F, u, rate / rest / T, T);", file=CORE),
+    Mutant("core_max_slips_counted_twice", "exact timing's closed form (E7) after 50 slips, not 100",
+           "slips++;", "slips += 2;", file=CORE),
+    Mutant("core_periodic_across_sign", "E7's closed form with the part across u turned",
+           "+ shrink * q[k];", "- shrink * q[k];", file=CORE),
+    Mutant("core_slid_at_zero_cycle", "E7 with a cycle of length 0 taken as periodic",
+           "if (!(L > 0.0)) {", "if (!(L >= 0.0)) {", file=CORE),
+)
 
-
+# LIGGGHTS: its host part of the law, liggghts_plugin/tangential_model_stick_slip.h (the
+# spring's turn, the trial force, the coefficients per type pair, the history's life)
+LIGGGHTS_LAW = "liggghts_plugin/tangential_model_stick_slip.h"
 LIGGGHTS_MUTANTS = (
     Mutant("fmin_step_0.3pct", "Fmin off by 0.3 %",
-           "const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn;",
-           "const double fmin = (2.0 * mu_k[sidata.itype][sidata.jtype] - ms) * fn * 1.003;"),
+           "const double fmin = StickSlipCore::kinetic(ms, mu_k[sidata.itype][sidata.jtype]) * fn;",
+           "const double fmin = StickSlipCore::kinetic(ms, mu_k[sidata.itype][sidata.jtype]) * fn * 1.003;"),
     Mutant("fmin_exact_0.3pct", "Fmin off by 0.3 %",
-           "const double fmin = (2.0 * mk - ms) * fn;", "const double fmin = (2.0 * mk - ms) * fn * 1.003;"),
-    Mutant("threshold_gt_step", "> for >= at the threshold",
-           "bool slip = mag2 >= limit * limit;", "bool slip = mag2 > limit * limit;"),
-    Mutant("threshold_gt_exact_start", "> for >= at the threshold",
-           "const bool start_over = start2 >= limit * limit;", "const bool start_over = start2 > limit * limit;"),
-    Mutant("threshold_gt_exact_loop", "> for >= at the threshold",
-           "if (slips == 0 && F2 >= T * T) dtheta = 0.0;", "if (slips == 0 && F2 > T * T) dtheta = 0.0;"),
-    Mutant("reset_spring_sign", "sign error in the spring reset",
-           "reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;",
-           "reset_total ? -(F[k] + gammat * vs[k]) / kt : F[k] / kt;"),
-    Mutant("reset_total_sign", "sign error in the spring reset",
-           "reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;",
-           "reset_total ? -(F[k] - gammat * vs[k]) / kt : -F[k] / kt;"),
-    Mutant("reset_exact_end_sign", "sign error in the spring reset",
-           "D[k] = -(trial[k] + gammat * vs[k]) / kt;", "D[k] = -(trial[k] - gammat * vs[k]) / kt;"),
+           "kin * fn, kin / ms, reset_total,", "kin * fn * 1.003, kin / ms, reset_total,"),
+    Mutant("threshold_unsquared", "> for >= at the threshold",
+           "bool slip = StickSlipCore::slips(mag2, limit * limit);", "bool slip = StickSlipCore::slips(mag2, limit);"),
     Mutant("dashpot_sign", "sign error in the dashpot",
            "F[k] = -kt * D[k] - gammat * vs[k];", "F[k] = -kt * D[k] + gammat * vs[k];"),
-    Mutant("dashpot_sign_exact_start", "sign error in the dashpot",
-           "const double F00 = F[0] + ktdt * vs[0], F01 = F[1] + ktdt * vs[1], F02 = F[2] + ktdt * vs[2];",
-           "const double F00 = F[0] - ktdt * vs[0], F01 = F[1] - ktdt * vs[1], F02 = F[2] - ktdt * vs[2];"),
+    Mutant("reset_dashpot_sign", "sign error in the spring reset",
+           "const double fdamp[3] = { -gammat * vs[0], -gammat * vs[1], -gammat * vs[2] };",
+           "const double fdamp[3] = { gammat * vs[0], gammat * vs[1], gammat * vs[2] };"),
     Mutant("turn_loses_length", "a turned history that loses its length",
            "scale = new2 > 0.0 ? std::sqrt(old2 / new2) : 1.0;", "scale = 1.0;"),
     Mutant("turn_series_loses_length", "a turned history that loses its length",
            "double scale = 1.0 + x * (0.5 + 0.375 * x);", "double scale = 1.0;"),
-    Mutant("exact_misses_whole_cycles", "exact timing that misses a slip inside the step",
-           "const double n = std::floor(rest / L);", "const double n = 0.0;"),
-    Mutant("exact_misses_slip_at_start", "exact timing that misses a slip inside the step",
-           "slip = slip || start_over;", "slip = slip;"),
-    Mutant("exact_slip_late", "exact timing that misses a slip inside the step",
-           "dtheta = rate > 0.0 ? gap / rate : INFINITY;", "dtheta = rate > 0.0 ? 1.5 * gap / rate : INFINITY;"),
+    Mutant("exact_start_ignored", "exact timing that misses a slip inside the step",
+           "slip = StickSlipCore::exact_step(slip, F, D, vs, kt, gammat, dt,",
+           "slip = StickSlipCore::exact_step(slip, F, D, vs, kt, gammat, 0.0,"),
     Mutant("mu_s_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
            "const double ms = mu_s[sidata.itype][sidata.jtype];",
            "const double ms = mu_s[sidata.itype][sidata.itype];"),
     Mutant("mu_k_wrong_pair_step", "a per-type-pair coefficient read from the wrong pair",
-           "(2.0 * mu_k[sidata.itype][sidata.jtype] - ms)", "(2.0 * mu_k[sidata.jtype][sidata.jtype] - ms)"),
+           "StickSlipCore::kinetic(ms, mu_k[sidata.itype][sidata.jtype]) * fn;",
+           "StickSlipCore::kinetic(ms, mu_k[sidata.jtype][sidata.jtype]) * fn;"),
     Mutant("mu_k_wrong_pair_exact", "a per-type-pair coefficient read from the wrong pair",
-           "const double mk = mu_k[sidata.itype][sidata.jtype];",
-           "const double mk = mu_k[sidata.itype][sidata.itype];"),
-    Mutant("reset_total_ignored_step", "the reset rule `total` ignored",
-           "reset_total ? -(F[k] + gammat * vs[k]) / kt : -F[k] / kt;", "-F[k] / kt;"),
-    Mutant("reset_total_ignored_exact", "the reset rule `total` ignored",
-           "const double kept = reset_total ? 0.0 : gammat * speed;", "const double kept = gammat * speed;"),
+           "const double kin = StickSlipCore::kinetic(ms, mu_k[sidata.itype][sidata.jtype]);",
+           "const double kin = StickSlipCore::kinetic(ms, mu_k[sidata.itype][sidata.itype]);"),
     Mutant("recontact_keeps_spring", "re-contact does not start from a zero spring",
-           "STICK_SLIP_COUNT(STAMP_FRESH); D[0] = D[1] = D[2] = 0.0;", "STICK_SLIP_COUNT(STAMP_FRESH);"),
+           "if (fresh) D[0] = D[1] = D[2] = 0.0;", ""),
     Mutant("wall_close_keeps_spring", "re-contact does not start from a zero spring",
            "hist[0] = hist[1] = hist[2] = 0.0;", ""),
     Mutant("fn_signed", "|Fn| for a tensile Fn",
            "const double fn = std::fabs(sidata.Fn);", "const double fn = sidata.Fn;"),
-    Mutant("flow_ignores_reset_total", "the reset rule `total` ignored",
-           "const bool flow_law = r == 1.0 && (reset_total || gammat == 0.0);",
-           "const bool flow_law = r == 1.0 && gammat == 0.0;"),
-) + exact_path_mutants()
+) + CORE_MUTANTS
 
-# LAMMPS: the law is stick_slip_law.h (steps 3-5, the inline E4 of the exact timing),
-# exact_slip_timing.h (E1-E7), and the pair style's and wall's code around it (coefficients
-# per type pair, the history dropped when a contact ends). Every `find` is a statement of
-# the law as it reads, long enough to be found once.
-LAW_H, EXACT_H, PAIR_CPP, WALL_CPP = ("stick_slip_law.h", "exact_slip_timing.h", "pair_gran_hooke_stickslip.cpp",
-                                      "fix_wall_gran_stickslip.cpp")
-LAMMPS_EXACT_H = "granular/" + EXACT_H  # (shared with the sub-model, in its folder)
+# LAMMPS 2021: the styles' part of the law, lammps_plugin/stick_slip_law.h (the turn, the
+# trial force, stock's rescale for reset total), and the pair style's and wall's code around
+# it (coefficients per type pair, the history dropped when a contact ends)
+LAW_H, PAIR_CPP, WALL_CPP = ("lammps_plugin/stick_slip_law.h", "lammps_plugin/pair_gran_hooke_stickslip.cpp",
+                             "lammps_plugin/fix_wall_gran_stickslip.cpp")
 LAMMPS_MUTANTS = (
     Mutant("fmin_step_0.3pct", "Fmin off by 0.3 %",
            "const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;",
            "const double ratio = sum > 0.0 ? c.kin * fnabs * 1.003 / std::sqrt(sum) : 0.0;"),
     Mutant("fmin_exact_0.3pct", "Fmin off by 0.3 %",
-           "limit = c.mu_s * fnabs, fmin = c.kin * fnabs;", "limit = c.mu_s * fnabs, fmin = c.kin * fnabs * 1.003;"),
-    Mutant("threshold_gt_step", "> for >= at the threshold",
-           "bool slipped = sum >= limit * limit;", "bool slipped = sum > limit * limit;"),
-    Mutant("threshold_gt_exact_start", "> for >= at the threshold",
-           "slipped = slipped || start2 >= limit * limit;", "slipped = slipped || start2 > limit * limit;"),
-    Mutant("threshold_gt_exact_e4", "> for >= at the threshold",
-           "if (start2 >= limit * limit && limit > 0.0 && !s.reset_total",
-           "if (start2 > limit * limit && limit > 0.0 && !s.reset_total"),
-    Mutant("threshold_gt_exact_loop", "> for >= at the threshold",
-           "if (slips == 0 && F2 >= T * T)", "if (slips == 0 && F2 > T * T)", file=LAMMPS_EXACT_H),
-    Mutant("reset_spring_sign", "sign error in the spring reset",
-           "for (int k = 0; k < 3; k++) D[k] = -fs[k] / kt;", "for (int k = 0; k < 3; k++) D[k] = fs[k] / kt;"),
+           "c.kin * fnabs, c.ratio, s.reset_total, stick);", "c.kin * fnabs * 1.003, c.ratio, s.reset_total, stick);"),
+    Mutant("threshold_unsquared", "> for >= at the threshold",
+           "bool slipped = LAMMPS_NS::StickSlipCore::slips(sum, limit * limit);",
+           "bool slipped = LAMMPS_NS::StickSlipCore::slips(sum, limit);"),
     Mutant("reset_total_sign", "sign error in the spring reset",
            "D[k] = ratio * (D[k] + dv) - dv;", "D[k] = ratio * (D[k] + dv) + dv;"),
-    Mutant("reset_exact_end_sign", "sign error in the spring reset",
-           "D[k] = -(trial[k] + nu_s * vtr[k]) / kt;", "D[k] = -(trial[k] - nu_s * vtr[k]) / kt;"),
-    Mutant("reset_exact_e4_sign", "sign error in the spring reset",
-           "D[k] = akt * vtr[k];", "D[k] = -akt * vtr[k];"),
     Mutant("dashpot_sign", "sign error in the dashpot",
            "fs[0] = -(kt * D[0] + nu_s * vtr[0]); fs[1] = -(kt * D[1] + nu_s * vtr[1]); "
            "fs[2] = -(kt * D[2] + nu_s * vtr[2]);",
            "fs[0] = -(kt * D[0] - nu_s * vtr[0]); fs[1] = -(kt * D[1] - nu_s * vtr[1]); "
            "fs[2] = -(kt * D[2] - nu_s * vtr[2]);"),
-    Mutant("exact_start_sign", "sign error in the trial force at the step's start (exact timing)",
-           "{fs[0] + ktdt * vtr[0], fs[1] + ktdt * vtr[1], fs[2] + ktdt * vtr[2]}",
-           "{fs[0] - ktdt * vtr[0], fs[1] - ktdt * vtr[1], fs[2] - ktdt * vtr[2]}"),
     Mutant("turn_loses_length", "a turned history that loses its length",
            "scale = new2 > 0.0 ? std::sqrt(old2 / new2) : 1.0;", "scale = 1.0;"),
     Mutant("turn_series_loses_length", "a turned history that loses its length",
            "double scale = 1.0 + x * (0.5 + 0.375 * x);", "double scale = 1.0;"),
-    Mutant("exact_misses_whole_cycles", "exact timing that misses a slip inside the step",
-           "const double n = std::floor(rest / L);", "const double n = 0.0;", file=LAMMPS_EXACT_H),
-    Mutant("exact_misses_slip_at_start", "exact timing that misses a slip inside the step",
-           "slipped = slipped || start2 >= limit * limit;", "slipped = slipped;"),
-    Mutant("exact_slip_late", "exact timing that misses a slip inside the step",
-           "dtheta = rate > 0.0 ? gap / rate : INFINITY;", "dtheta = rate > 0.0 ? 1.5 * gap / rate : INFINITY;",
-           file=LAMMPS_EXACT_H),
+    Mutant("exact_start_ignored", "exact timing that misses a slip inside the step",
+           "slipped, fs, D, vtr, kt, nu_s, update ? dt : 0.0, limit,", "slipped, fs, D, vtr, kt, nu_s, 0.0, limit,"),
     Mutant("coeffs_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
            "tangential_force<Mode>(s, coeffs_i[type[j]],", "tangential_force<Mode>(s, coeffs_i[type[i]],",
            file=PAIR_CPP),
@@ -200,10 +200,8 @@ LAMMPS_MUTANTS = (
     Mutant("single_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
            "const Coeffs &c = coeffs[itype][jtype];", "const Coeffs &c = coeffs[itype][itype];", file=PAIR_CPP),
     Mutant("reset_total_ignored_step", "the reset rule `total` ignored",
-           "if (!s.reset_total) for (int k = 0; k < 3; k++) D[k] = -fs[k] / kt;",
-           "for (int k = 0; k < 3; k++) D[k] = -fs[k] / kt;"),
-    Mutant("reset_total_ignored_exact", "the reset rule `total` ignored",
-           "const double kept = reset_total ? 0.0 : nu_s * speed;", "const double kept = nu_s * speed;", file=LAMMPS_EXACT_H),
+           "if (!s.reset_total) LAMMPS_NS::StickSlipCore::reset(fs, nullptr, kt, false, D);",
+           "LAMMPS_NS::StickSlipCore::reset(fs, nullptr, kt, false, D);"),
     Mutant("recontact_keeps_spring_pair", "re-contact does not start from a zero spring",
            "for (int m = 0; m < dnum; m++) hist[m] = 0.0; continue;", "continue;", file=PAIR_CPP),
     # (the end of the statement only: the LAMMPS speed work renames the history array)
@@ -211,10 +209,7 @@ LAMMPS_MUTANTS = (
            "[m] = 0.0; continue;", "[m] += 0.0; continue;", file=WALL_CPP),
     Mutant("fn_signed", "|Fn| for a tensile Fn",
            "const double fnabs = std::fabs(ccel_r);", "const double fnabs = ccel_r;"),
-    Mutant("flow_ignores_reset_total", "the reset rule `total` ignored",
-           "const bool flow_law = c.ratio == 1.0 && (s.reset_total || nu_s == 0.0);",
-           "const bool flow_law = c.ratio == 1.0 && nu_s == 0.0;"),
-) + exact_path_mutants(LAMMPS_EXACT_H)
+) + CORE_MUTANTS
 
 # DEM-Engine: the force model deme_model/stick_slip.cu, built on the CPU through its shim
 # (deme_model/CMakeLists.txt); the same kinds, found in its own text.
@@ -298,55 +293,30 @@ DEME_MUTANTS = (
            "<= 1e-4 * ss_rad) {", "<= 1e30 * ss_rad) {"),
 )
 
-# LAMMPS 2025's sub-model: lammps_plugin/granular/gran_sub_mod_tangential_stick_slip.cpp (steps
-# 3-5, E0) and exact_slip_timing.h (E1-E7), compiled into LAMMPS (build_lammps_2025).
-SUB_CPP, SUB_H = "gran_sub_mod_tangential_stick_slip.cpp", "gran_sub_mod_tangential_stick_slip.h"
+# The LAMMPS sub-model: its host part, lammps_plugin/granular/gran_sub_mod_tangential_stick_slip.cpp
+# (the turn, the trial force, the rescale, the record), compiled into LAMMPS 4 Feb 2025 (whose
+# turn is the sub-model's own arithmetic, where 4 Jul 2026 calls its host's helper).
+SUB_CPP, SUB_H = ("lammps_plugin/granular/gran_sub_mod_tangential_stick_slip.cpp",
+                  "lammps_plugin/granular/gran_sub_mod_tangential_stick_slip.h")
 LAMMPS_GRANULAR_MUTANTS = (
     Mutant("fmin_0.3pct", "Fmin off by 0.3 %",
-           "const double fmin = fncrit * kin;", "const double fmin = fncrit * kin * 1.003;", count=2),
-    Mutant("threshold_gt_step", "> for >= at the threshold",
-           "bool slipped = magfs >= Fscrit;", "bool slipped = magfs > Fscrit;"),
-    Mutant("threshold_gt_exact_start", "> for >= at the threshold",
-           "slipped = slipped || start2 >= Fscrit * Fscrit;", "slipped = slipped || start2 > Fscrit * Fscrit;"),
-    Mutant("threshold_gt_exact_loop", "> for >= at the threshold",
-           "if (slips == 0 && F2 >= T * T)", "if (slips == 0 && F2 > T * T)", file=EXACT_H),
-    Mutant("reset_spring_sign", "sign error in the spring reset",
-           "const double back = -1.0 / ks;", "const double back = 1.0 / ks;"),
-    Mutant("reset_total_sign", "sign error in the spring reset",
-           "if (TOTAL) D[i] = D[i] + dv[i];", "if (TOTAL) D[i] = D[i] - dv[i];"),
-    Mutant("reset_exact_end_sign", "sign error in the spring reset",
-           "D[i] = -(trial[i] + dv[i]) / ks;", "D[i] = -(trial[i] - dv[i]) / ks;"),
+           "const double magfs = len3(F), fmin = fncrit * kin;", "const double magfs = len3(F), fmin = fncrit * kin * 1.003;"),
+    Mutant("rescale_fmin_0.3pct", "Fmin off by 0.3 %",
+           "rescale_factor(gm, fmin, magfs)", "rescale_factor(gm, fmin * 1.003, magfs)"),
     Mutant("dashpot_sign", "sign error in the dashpot",
-           "F[i] = -ks * D[i] - dv[i];", "F[i] = -ks * D[i] + dv[i];"),
-    Mutant("exact_start_sign", "sign error in the trial force at the step's start (exact timing)",
-           "const double start[3] = {F[0] + ksdt * v[0], F[1] + ksdt * v[1],",
-           "const double start[3] = {F[0] - ksdt * v[0], F[1] - ksdt * v[1],"),
-    Mutant("exact_e4_shortcut_sign", "sign error in the spring reset",
-           "D[i] = aks * v[i];", "D[i] = -aks * v[i];"),
-    Mutant("threshold_gt_exact_e4", "> for >= at the threshold",
-           "if (!TOTAL && start2 >= Fscrit * Fscrit && Fscrit > 0.0", "if (!TOTAL && start2 > Fscrit * Fscrit && Fscrit > 0.0"),
+           "for (int i = 0; i < 3; i++) F[i] = -ks * D[i] + fdamp[i];",
+           "for (int i = 0; i < 3; i++) F[i] = -ks * D[i] - fdamp[i];"),
+    Mutant("exact_start_ignored", "exact timing that misses a slip inside the step",
+           "StickSlipCore::exact_step(slipped, F, D, v, ks, damp, update ? gm->dt : 0.0, Fscrit,",
+           "StickSlipCore::exact_step(slipped, F, D, v, ks, damp, 0.0, Fscrit,"),
     Mutant("turn_loses_length", "a turned history that loses its length",
-           "scale3(prjmag > 0 ? shrmag / prjmag : 0, D);", ""),
-    Mutant("exact_misses_whole_cycles", "exact timing that misses a slip inside the step",
-           "const double n = std::floor(rest / L);", "const double n = 0.0;", file=EXACT_H),
-    Mutant("exact_misses_slip_at_start", "exact timing that misses a slip inside the step",
-           "slipped = slipped || start2 >= Fscrit * Fscrit;", "slipped = slipped;"),
-    Mutant("exact_slip_late", "exact timing that misses a slip inside the step",
-           "dtheta = rate > 0.0 ? gap / rate : INFINITY;", "dtheta = rate > 0.0 ? 1.5 * gap / rate : INFINITY;",
-           file=EXACT_H),
-    Mutant("reset_total_ignored_step", "the reset rule `total` ignored",
-           "if (TOTAL) D[i] = D[i] + dv[i];", ""),
-    Mutant("reset_total_ignored_exact", "the reset rule `total` ignored",
-           "const double kept = reset_total ? 0.0 : nu_s * speed;", "const double kept = nu_s * speed;", file=EXACT_H),
+           "scale3(prjmag > 0 ? shrmag / prjmag : 0, v);", ""),
     Mutant("total_name_wrong_class", "the reset rule `total` ignored",
-           "GranSubModStyle(stick_slip/total,GranSubModTangentialStickSlipTotal,TANGENTIAL);",
-           "GranSubModStyle(stick_slip/total,GranSubModTangentialStickSlipPlain,TANGENTIAL);", file=SUB_H),
+           "GranSubModStyle(stick_slip/total,GranSubModStickSlipTotal,TANGENTIAL);",
+           "GranSubModStyle(stick_slip/total,GranSubModTangentialStickSlip,TANGENTIAL);", file=SUB_H),
     Mutant("exact_name_wrong_class", "exact timing that misses a slip inside the step",
-           "GranSubModStyle(stick_slip/exact/record,GranSubModTangentialStickSlipExactRecord,TANGENTIAL);",
-           "GranSubModStyle(stick_slip/exact/record,GranSubModTangentialStickSlipRecord,TANGENTIAL);", file=SUB_H),
-    Mutant("flow_ignores_reset_total", "the reset rule `total` ignored",
-           "const bool flow_law = ratio == 1.0 && (TOTAL || damp == 0.0);",
-           "const bool flow_law = ratio == 1.0 && damp == 0.0;"),
+           "GranSubModStyle(stick_slip/exact/record,GranSubModStickSlipExactRecord,TANGENTIAL);",
+           "GranSubModStyle(stick_slip/exact/record,GranSubModStickSlipRecord,TANGENTIAL);", file=SUB_H),
     Mutant("slip_counted_twice", "a wrong slip count in the record",
            "if (slipped) history[HIST_NSLIP] += 1.0;", "if (slipped) history[HIST_NSLIP] += 2.0;"),
     Mutant("record_fn_unsigned_damping", "the record's Fn not the one applied",
@@ -354,14 +324,13 @@ LAMMPS_GRANULAR_MUTANTS = (
     Mutant("mixed_mu_from_one_side", "a per-type-pair coefficient read from the wrong pair",
            "coeffs[i] = mix_geom(icoeffs[i], jcoeffs[i]);", "coeffs[i] = mix_geom(icoeffs[i], icoeffs[i]);"),
     Mutant("slips_negated_across", "a wrong slip count in the record",
-           "transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP] = transfer_history_factor[HIST_WORK]",
-           "transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_WORK]"),
+           "transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP] = 1.0;",
+           "transfer_history_factor[HIST_FN] = 1.0;"),
     Mutant("work_negated_across", "a wrong dissipated work in the record",
-           "transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP] = transfer_history_factor[HIST_WORK]",
-           "transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP]"),
+           "transfer_history_factor[HIST_WORK] = 1.0;", ""),
     Mutant("history_transfer_default", "the spring seen from the other grain with the record's values negated",
            "nondefault_history_transfer = 1;", "nondefault_history_transfer = 0;"),
-) + exact_path_mutants(EXACT_H)
+) + CORE_MUTANTS
 
 
 def build_lammps_2025(src: Path, out: Path, quick=True, cmake_args=()):
@@ -387,13 +356,13 @@ def build_lammps_2025(src: Path, out: Path, quick=True, cmake_args=()):
 
 ENGINES = {
     "lammps_granular": Engine(
-        source="lammps_plugin/granular", law_file=SUB_CPP, build_env="STICKSLIP_LAMMPS_2025",
+        source="lammps_plugin/granular", law_file=SUB_CPP, build_env="STICKSLIP_LAMMPS_GRANULAR",
         fast=("tests/test_law_contract.py", "-k", "lammps_granular"),
         wide=("tests/test_lammps_granular.py", "tests/test_lammps_granular_dropin.py",
               "tests/test_lammps_granular_restart.py"),
         mutants=LAMMPS_GRANULAR_MUTANTS, builder=build_lammps_2025),
     "liggghts": Engine(
-        source="liggghts_plugin", law_file="tangential_model_stick_slip.h", build_env="STICKSLIP_LIGGGHTS_BUILD",
+        source="liggghts_plugin", law_file=LIGGGHTS_LAW, build_env="STICKSLIP_LIGGGHTS_BUILD",
         fast=("tests/test_law_contract.py", "-k", "liggghts"),
         wide=("tests/test_liggghts_plugin.py", "tests/test_liggghts_engine.py", "tests/test_liggghts_dropin.py",
               "tests/test_stability_engines.py", "tests/test_drum.py", "tests/test_precision.py",
@@ -409,7 +378,7 @@ ENGINES = {
         # the LAMMPS headers ./run.sh setup extracted (CMakeLists' default is relative to its source)
         cmake_args=(f"-DLAMMPS_HEADERS={REPO / 'build' / 'lammps_headers' / 'src'}",)),
     "deme": Engine(
-        source="deme_model", law_file="stick_slip.cu", build_env="STICKSLIP_DEME_SHIM_BUILD",
+        source="deme_model", law_file="deme_model/stick_slip.cu", build_env="STICKSLIP_DEME_SHIM_BUILD", copies=(),
         fast=("tests/test_deme_shim.py",),
         wide=("tests/test_deme_shim.py", "tests/test_deme_adapter.py"),
         mutants=DEME_MUTANTS),
@@ -460,14 +429,17 @@ def main(argv=None):
     eng = ENGINES[args.engine]
     mutants = [m for m in eng.mutants if not args.only or m.id in args.only]
     work = REPO / "build" / "mutants" / args.engine
-    src, out, out_release = work / "src", work / "build", work / "build-release"
+    # the copies keep the repository's layout (the LIGGGHTS plugin reaches the core at ../lammps_plugin)
+    root, out, out_release = work / "src", work / "build", work / "build-release"
     if eng.builder is not None:  # (one build serves both selections)
         out_release = out
     build = eng.builder or build_with_cmake
-    if src.exists():
-        shutil.rmtree(src)
-    shutil.copytree(REPO / eng.source, src)
-    originals = {f: (src / f).read_text() for f in {m.file or eng.law_file for m in mutants}}
+    if root.exists():
+        shutil.rmtree(root)
+    for folder in (eng.source, *eng.copies):
+        shutil.copytree(REPO / folder, root / folder, dirs_exist_ok=True)
+    src = root / eng.source
+    originals = {f: (root / f).read_text() for f in {m.file or eng.law_file for m in mutants}}
     env = dict(os.environ, **{eng.build_env: str(out)})
     env_release = dict(os.environ, **{eng.build_env: str(out_release)})
     t_start = time.perf_counter()
@@ -494,9 +466,9 @@ def main(argv=None):
             if m.id not in texts:
                 continue
             for file, text in originals.items():  # (the last mutant's file back as it was)
-                (src / file).write_text(text)
+                (root / file).write_text(text)
             file, text = texts[m.id]
-            (src / file).write_text(text)
+            (root / file).write_text(text)
             t0 = time.perf_counter()
             ok, log = build(src, out, **quick)
             if not ok:
@@ -515,7 +487,7 @@ def main(argv=None):
             print(f"{m.id:28s} {verdict:8s} {time.perf_counter() - t0:5.0f} s  {by}", flush=True)
     finally:
         for file, text in originals.items():
-            (src / file).write_text(text)
+            (root / file).write_text(text)
         build(src, out, **quick)  # leave the copies built as the repository's source
         if out_release.exists():
             build(src, out_release, **release)

@@ -1,67 +1,163 @@
-/* SPDX-License-Identifier: GPL-2.0-or-later
-   ----------------------------------------------------------------------
-   stickslip: the stick-slip tangential law of Khellaf & Mansouri (2024) as a tangential
-   sub-model of LAMMPS' granular model (docs/law.md; equation numbers are the paper's).
+/* ----------------------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
 
-   This file is the law on LAMMPS 2Aug2023 and later. The host computes the geometry, the
-   sliding velocity V_s (gm->vtr, with the radii as lever arms), the normal force and its
-   damping, and applies the force and torques; this sub-model turns and loads the spring D
-   and decides stick or slip. Its step-timing arithmetic is linear_history's operation for
-   operation (the turn of D keeping its length included), so that with mu_k = mu_s and
-   /total it gives linear_history's run bit for bit. The exact slip timing's
-   engine-independent part (E1-E7) is exact_slip_timing.h, shared with the styles of
-   lammps_plugin/ for Debian's LAMMPS.
+   Copyright (2003) Sandia Corporation.  Under the terms of Contract
+   DE-AC04-94AL85000 with Sandia Corporation, the U.S. Government retains
+   certain rights in this software.  This software is distributed under
+   the GNU General Public License.
+
+   See the README file in the top-level LAMMPS directory.
+------------------------------------------------------------------------- */
+
+/* ----------------------------------------------------------------------
+   Contributing authors: the stickslip developers
+   Stick-slip friction of Khellaf and Mansouri, Technology Audit and
+   Production Reserves 4(1(78)), 17-25 (2024), equations numbered as there
 ------------------------------------------------------------------------- */
 
 #include "gran_sub_mod_tangential_stick_slip.h"
 
-#include "comm.h"
+#include "citeme.h"
 #include "error.h"
-#include "exact_slip_timing.h"
 #include "gran_sub_mod_damping.h"
 #include "gran_sub_mod_normal.h"
 #include "granular_model.h"
 #include "math_extra.h"
-#include "stickslip_version.h"
+#include "stick_slip_core.h"
 
 #include <cmath>
-#include <string>
+#include <type_traits>
+#include <utility>
 
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
 using namespace MathExtra;
 
-// linear_history's and mindlin's: D is turned into the tangent plane only when its normal
-// part carries more than EPSILON of the threshold (below that the turn changes nothing a
-// force could show)
+// as linear_history and mindlin: the spring is turned into the tangent plane only when its
+// normal part carries more than EPSILON of the threshold
 static constexpr double EPSILON = 1e-10;
+
+static const char cite_stick_slip[] =
+    "tangential stick_slip: doi:10.15587/2706-5448.2024.310428\n\n"
+    "@Article{khellaf2024stickslip,\n"
+    " author =  {Khellaf, Abdelghani and Mansouri, Mouloud},\n"
+    " title =   {Development of the stick-slip friction model for discrete elements modeling},\n"
+    " journal = {Technology Audit and Production Reserves},\n"
+    " year =    {2024},\n"
+    " volume =  {4},\n"
+    " number =  {1(78)},\n"
+    " pages =   {17--25}\n"
+    "}\n\n";
+
+/* ----------------------------------------------------------------------
+   The host release. LAMMPS after 4 Feb 2025 has synchronized verlet
+   (GranularModel::synchronized_verlet and nx_unrotated, GranSubMod::allow_synchronization),
+   turns a vector into the tangent plane with GranSubMod::rotate_rescale_vec, and its stock
+   sub-models rescale a force by Fscrit / |F|. LAMMPS 4 Feb 2025 has none of these, writes
+   the same turn out in each sub-model, and rescales by Fscrit * (1 / |F|). These helpers ask
+   the host which it is, so that at mu_k = mu_s the sub-model is that release's
+   linear_history (mindlin) to the last bit, and follows a later release's helper.
+------------------------------------------------------------------------- */
+
+namespace {
+template <class T, class = void> struct HasSynchronizedVerlet : std::false_type {
+};
+template <class T>
+struct HasSynchronizedVerlet<T, std::void_t<decltype(T::synchronized_verlet)>> : std::true_type {
+};
+
+template <class T, class = void> struct HasAllowSynchronization : std::false_type {
+};
+template <class T>
+struct HasAllowSynchronization<T, std::void_t<decltype(T::allow_synchronization)>> :
+    std::true_type {
+};
+
+template <class T, class = void> struct HasRotateRescale : std::false_type {
+};
+template <class T>
+struct HasRotateRescale<
+    T, std::void_t<decltype(std::declval<T &>().rotate_rescale_vec(nullptr, nullptr))>> :
+    std::true_type {
+};
+
+template <class Model> int synchronized(const Model *gm)
+{
+  if constexpr (HasSynchronizedVerlet<Model>::value)
+    return gm->synchronized_verlet == 1;
+  else
+    return 0;
+}
+
+template <class Model> double *full_step_normal(Model *gm)
+{
+  if constexpr (HasSynchronizedVerlet<Model>::value)
+    return gm->nx_unrotated;
+  else
+    return gm->nx;
+}
+
+template <class Sub> void set_allow_synchronization(Sub *sub, int flag)
+{
+  if constexpr (HasAllowSynchronization<Sub>::value) sub->allow_synchronization = flag;
+}
+
+// turn v into the plane normal to the unit vector n, keeping its length
+template <class Sub> void rotate_rescale(Sub *sub, double *v, double *n)
+{
+  if constexpr (HasRotateRescale<Sub>::value) {
+    sub->rotate_rescale_vec(v, n);
+  } else {
+    const double rsht = dot3(v, n), shrmag = len3(v);
+    double temp[3];
+    scale3(rsht, n, temp);
+    sub3(v, temp, v);
+    const double prjmag = len3(v);
+    scale3(prjmag > 0 ? shrmag / prjmag : 0, v);
+  }
+}
+
+// the factor that brings a force of magnitude magfs to target
+template <class Model> double rescale_factor(const Model *, double target, double magfs)
+{
+  if constexpr (HasSynchronizedVerlet<Model>::value)
+    return target / magfs;
+  else
+    return target * (1.0 / magfs);
+}
+}    // namespace
 
 /* ---------------------------------------------------------------------- */
 
-GranSubModTangentialStickSlip::GranSubModTangentialStickSlip(GranularModel *gm, LAMMPS *lmp, bool record) :
-    GranSubModTangential(gm, lmp), xt(0.0), kin(0.0), ratio(1.0), mindlin(false)
+GranSubModTangentialStickSlip::GranSubModTangentialStickSlip(GranularModel *gm, LAMMPS *lmp,
+                                                             int options) :
+    GranSubModTangential(gm, lmp),
+    reset_total(options & TOTAL), exact_timing(options & EXACT), record(options & RECORD),
+    mindlin(0), xt(0.0), kin(0.0), ratio(1.0)
 {
+  if (lmp->citeme) lmp->citeme->add(cite_stick_slip);
+
   num_coeffs = 4;
-  size_history = record ? SIZE_RECORD : SIZE_PLAIN;
-  nsvector = record ? NRECORD : 0;
+  size_history = record ? SIZE_RECORD : 3;
+  nsvector = record ? 6 : 0;
+  // exact timing integrates the spring along one tangent plane over the step; synchronized
+  // verlet turns it twice within the step
+  set_allow_synchronization(this, !exact_timing);
   if (record) {
-    // seen from the other body of a pair, D and F_s change sign; Fn, the slip count and the
-    // work do not
+    // seen from the other body of a pair the spring and the force change sign; the normal
+    // force, the slip count and the work do not
     nondefault_history_transfer = 1;
-    transfer_history_factor = new double[SIZE_RECORD];
-    for (int i = 0; i < SIZE_RECORD; i++) transfer_history_factor[i] = -1.0;
-    transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP] = transfer_history_factor[HIST_WORK] = 1.0;
+    transfer_history_factor = new double[size_history];
+    for (int i = 0; i < size_history; i++) transfer_history_factor[i] = -1.0;
+    transfer_history_factor[HIST_FN] = transfer_history_factor[HIST_NSLIP] = 1.0;
+    transfer_history_factor[HIST_WORK] = 1.0;
   }
-  // the version, once a process, where LAMMPS writes its own start-up lines
-  static bool said = false;
-  if (!said && comm->me == 0)
-    utils::logmesg(lmp, "stickslip " STICKSLIP_VERSION ": tangential sub-model stick_slip (Khellaf & Mansouri 2024)\n");
-  said = true;
 }
 
 /* ----------------------------------------------------------------------
-   coefficients: Ks (or NULL), x_gamma,t, mu_s, mu_k; each bad one stops the run with one
-   line naming it and its allowed range (docs/law.md "Parameter rules")
+   coefficients: Ks (or NULL), x_gamma,t, mu_s, mu_k
 ------------------------------------------------------------------------- */
 
 void GranSubModTangentialStickSlip::coeffs_to_local()
@@ -70,35 +166,39 @@ void GranSubModTangentialStickSlip::coeffs_to_local()
   xt = coeffs[1];
   mu = coeffs[2];
 
-  mindlin = ks == -1.0;    // NULL
+  mindlin = (ks == -1.0);
   if (!mindlin && !(ks > 0.0 && std::isfinite(ks)))
     error->all(FLERR,
-               "tangential {}: Ks = {} is outside its allowed range: > 0, or NULL (Mindlin's 8 G* a, with a "
-               "normal model of material properties)",
+               "Tangential {}: Ks = {} is outside its allowed range: > 0, or NULL (Mindlin's "
+               "8 G* a, with a normal model of material properties)",
                name, ks);
   if (!(xt >= 0.0 && std::isfinite(xt)))
-    error->all(FLERR, "tangential {}: x_gamma,t = {} is outside its allowed range: >= 0", name, xt);
+    error->all(FLERR, "Tangential {}: x_gamma,t = {} is outside its allowed range: >= 0", name, xt);
   if (!(mu > 0.0 && std::isfinite(mu)))
-    error->all(FLERR, "tangential {}: mu_s = {} is outside its allowed range: > 0", name, mu);
+    error->all(FLERR, "Tangential {}: mu_s = {} is outside its allowed range: > 0", name, mu);
   if (!(mu_k >= 0.5 * mu && mu_k <= mu))
-    error->all(FLERR, "tangential {}: mu_k = {} is outside its allowed range [mu_s/2, mu_s] = [{}, {}]", name,
-               mu_k, 0.5 * mu, mu);
+    error->all(FLERR,
+               "Tangential {}: mu_k = {} is outside its allowed range [mu_s/2, mu_s] = [{}, {}]",
+               name, mu_k, 0.5 * mu, mu);
 
   if (mindlin) {
     if (!gm->normal_model->get_material_properties())
       error->all(FLERR,
-                 "tangential {}: Ks = NULL needs a normal model with material properties (hertz/material, dmt, "
-                 "jkr, mdr); give Ks instead",
+                 "Tangential {}: Ks = NULL needs a normal model with material properties "
+                 "(hertz/material, dmt, jkr, mdr); give Ks instead",
                  name);
     const double Emod = gm->normal_model->get_emod(), poiss = gm->normal_model->get_poiss();
     // Mindlin's stiffness per unit contact radius, as the mindlin sub-model's
-    k = 8.0 * (gm->contact_type == PAIR ? mix_stiffnessG(Emod, Emod, poiss, poiss) : mix_stiffnessG_wall(Emod, poiss));
+    if (gm->contact_type == PAIR)
+      k = 8.0 * mix_stiffnessG(Emod, Emod, poiss, poiss);
+    else
+      k = 8.0 * mix_stiffnessG_wall(Emod, poiss);
   } else {
     k = ks;
   }
-  contact_radius_flag = mindlin ? 1 : 0;
+  contact_radius_flag = mindlin;
 
-  kin = 2.0 * mu_k - mu;    // Fmin = (2 mu_k - mu_s) Fn: mean mu_k Fn over a saw-tooth
+  kin = StickSlipCore::kinetic(mu, mu_k);
   ratio = kin / mu;
 }
 
@@ -106,174 +206,119 @@ void GranSubModTangentialStickSlip::coeffs_to_local()
 
 void GranSubModTangentialStickSlip::mix_coeffs(double *icoeffs, double *jcoeffs)
 {
-  // geometric means, as the other sub-models (they keep mu_s/2 <= mu_k <= mu_s); NULL
-  // (Mindlin's stiffness) if either side has it
-  coeffs[0] = (icoeffs[0] == -1.0 || jcoeffs[0] == -1.0) ? -1.0 : mix_geom(icoeffs[0], jcoeffs[0]);
+  // geometric means, as the other sub-models (they keep mu_s/2 <= mu_k <= mu_s); Mindlin's
+  // stiffness if either side has it
+  if (icoeffs[0] == -1.0 || jcoeffs[0] == -1.0)
+    coeffs[0] = -1.0;
+  else
+    coeffs[0] = mix_geom(icoeffs[0], jcoeffs[0]);
   for (int i = 1; i < num_coeffs; i++) coeffs[i] = mix_geom(icoeffs[i], jcoeffs[i]);
   coeffs_to_local();
 }
 
 /* ----------------------------------------------------------------------
-   with /record: the contact's record as the sub-model's output values (compute pair/local
-   p13-p18, the wall fixes' per-atom columns 9-14)
+   with /record: the contact's record as the sub-model's output values
 ------------------------------------------------------------------------- */
 
 void GranSubModTangentialStickSlip::report_record(const double *history)
 {
   double *out = &gm->svector[index_svector];
   out[0] = history[HIST_FN];
-  for (int k = 0; k < 3; k++) out[1 + k] = history[HIST_FS + k];
+  for (int i = 0; i < 3; i++) out[1 + i] = history[HIST_FS + i];
   out[4] = history[HIST_NSLIP];
   out[5] = history[HIST_WORK];
 }
 
-/* ----------------------------------------------------------------------
-   docs/law.md steps 3-5 (and E0-E7 with EXACT) at one contact for one force evaluation
-------------------------------------------------------------------------- */
+/* ---------------------------------------------------------------------- */
 
-template <bool TOTAL, bool EXACT, bool RECORD> void GranSubModTangentialStickSlip::step()
+void GranSubModTangentialStickSlip::calculate_forces()
 {
-  // (the contact's vectors in locals: stores through `history` could alias the model's
+  // (the contact's vectors in locals: a store through history could alias the model's
   // arrays, and the compiler would load them again after each)
   damp = xt * gm->damping_model->get_damp_prefactor();    // nu_s
-  const double fncrit = gm->normal_model->get_fncrit();      // |Fn| (adhesive models: their own)
-  const double Fscrit = fncrit * mu;                         // T = mu_s |Fn|
+  const double fncrit = gm->normal_model->get_fncrit();
+  const double Fscrit = fncrit * mu;
   const double ks = mindlin ? k * gm->contact_radius : k;
   double *history = &gm->history[history_index];
-  const double v[3] = {gm->vtr[0], gm->vtr[1], gm->vtr[2]};    // V_s (eq. 6)
+  const double v[3] = {gm->vtr[0], gm->vtr[1], gm->vtr[2]};    // V_s, eq. 6
   double D[3] = {history[0], history[1], history[2]};
-  const double before2 = RECORD ? lensq3(D) : 0.0;
+  const double before2 = record ? lensq3(D) : 0.0;
   double *fs = gm->fs;
 
-  const bool update = gm->history_update;    // false: a set-up evaluation, no time passes
+  const int update = gm->history_update;    // 0: a set-up evaluation, no time passes
+  const int sync = synchronized(gm);
+  int frame_update = 0;
   if (update) {
-    // step 3: turn D into the current tangent plane keeping its length (linear_history's
-    // arithmetic)
-    const double *nx = gm->nx;
-    const double rsht = dot3(D, nx);
-    if (fabs(rsht) * ks > EPSILON * Fscrit) {
-      const double shrmag = len3(D);
-      for (int i = 0; i < 3; i++) D[i] = D[i] - rsht * nx[i];
-      const double prjmag = len3(D);
-      scale3(prjmag > 0 ? shrmag / prjmag : 0, D);
-    }
-    // eq. 7: D += V_s dt
+    // turn the spring into the current tangent plane keeping its length, load it (eq. 7),
+    // and with synchronized verlet turn it into the full step's plane (as linear_history)
+    double *nx = gm->nx;
+    double rsht = dot3(D, nx);
+    frame_update = fabs(rsht) * ks > EPSILON * Fscrit;
+    if (frame_update) rotate_rescale(this, D, nx);
     const double dt = gm->dt;
     for (int i = 0; i < 3; i++) D[i] = D[i] + dt * v[i];
+    if (sync) {
+      double *nx_full = full_step_normal(gm);
+      rsht = dot3(D, nx_full);
+      frame_update = fabs(rsht) * ks > EPSILON * Fscrit;
+      if (frame_update) rotate_rescale(this, D, nx_full);
+    }
   } else if (gm->contact_type == PAIR && gm->calculate_svector) {
-    // pair granular's single() (compute pair/local): report, change nothing
-    if (RECORD) {
+    // pair granular's single(): report, change nothing
+    if (record) {
       copy3(&history[HIST_FS], fs);
       report_record(history);
     } else {
       // the force the law would apply now, with no time passing
       for (int i = 0; i < 3; i++) fs[i] = -ks * D[i] - damp * v[i];
       const double magfs = len3(fs);
-      if (magfs >= Fscrit) scale3(magfs > 0.0 && lensq3(D) != 0.0 ? fncrit * kin / magfs : 0.0, fs);
+      if (StickSlipCore::slips(magfs, Fscrit))
+        scale3(magfs > 0.0 && lensq3(D) != 0.0 ? fncrit * kin / magfs : 0.0, fs);
     }
     return;
   }
 
   // eq. 5: the trial force, spring + dashpot
-  double F[3], dv[3];
-  for (int i = 0; i < 3; i++) {
-    dv[i] = damp * v[i];
-    F[i] = -ks * D[i] - dv[i];
+  double fdamp[3], F[3];
+  if (frame_update && sync) {
+    double vturned[3] = {v[0], v[1], v[2]};
+    rotate_rescale(this, vturned, full_step_normal(gm));
+    scale3(-damp, vturned, fdamp);
+  } else {
+    scale3(-damp, v, fdamp);
   }
+  for (int i = 0; i < 3; i++) F[i] = -ks * D[i] + fdamp[i];
 
-  // step 5: slip if |F_t| >= mu_s |Fn|
-  const double magfs = len3(F);
-  bool slipped = magfs >= Fscrit;
-  if (EXACT) {
-    // E0: |F| moves on a line in the step and is convex, so the step has no slip iff the
-    // trial force is below T at both ends; then the result is the step timing's. The
-    // trial force at the start holds the spring before its increment: F + Ks dt V_s (a set-up
-    // evaluation is a step of length 0).
-    const double ksdt = update ? ks * gm->dt : 0.0;
-    const double start[3] = {F[0] + ksdt * v[0], F[1] + ksdt * v[1], F[2] + ksdt * v[2]};
-    const double start2 = lensq3(start);
-    slipped = slipped || start2 >= Fscrit * Fscrit;
-    if (slipped) {
-      const double fmin = fncrit * kin;    // Fmin (eq. 8)
-      const double vs2 = lensq3(v), damp2 = damp * damp;
-      if (!TOTAL && start2 >= Fscrit * Fscrit && Fscrit > 0.0 && damp2 * vs2 > 0.0 &&
-          (fmin * fmin + damp2 * vs2 - Fscrit * Fscrit) * sqrt(start2) - 2.0 * fmin * damp * dot3(start, v) >= 0.0) {
-        // E4 at the step's start, the common slipping case of a flowing bed: the force is at
-        // or above T at theta = 0, and after the slip the dashpot alone keeps it there,
-        // |Fmin t0 + nu_s |V_s| u| >= T (t0 = F0/|F0|, u = -V_s/|V_s|; expanded: one square
-        // root, no division). It slides at Fmin u all step; the spring holds the trial force
-        // (Fmin + nu_s |V_s|) u less the dashpot (eq. 5). exact_slips' closed form, inline.
-        const double a = fmin / sqrt(vs2), aks = a / ks;
-        for (int i = 0; i < 3; i++) {
-          F[i] = -a * v[i];
-          D[i] = aks * v[i];
-        }
-      } else {
-        // E1-E7 (exact_slip_timing.h); E6 when nothing is added at a reset
-        const bool flow_law = ratio == 1.0 && (TOTAL || damp == 0.0);
-        double applied[3], trial[3], stick;
-        stickslip::exact_slips(start, v, Fscrit, fmin, ratio, ks, damp, update ? gm->dt : 0.0, TOTAL, flow_law, applied,
-                               trial, stick);
-        // the spring holds the trial force at the end less the dashpot (eq. 5)
-        for (int i = 0; i < 3; i++) {
-          F[i] = applied[i];
-          D[i] = -(trial[i] + dv[i]) / ks;
-        }
-      }
-    }
+  // the slip test, then eq. 8 or exact timing (stick_slip_core.h)
+  const double magfs = len3(F), fmin = fncrit * kin;
+  int slipped = StickSlipCore::slips(magfs, Fscrit);
+  if (exact_timing) {
+    double stick;
+    slipped = StickSlipCore::exact_step(slipped, F, D, v, ks, damp, update ? gm->dt : 0.0, Fscrit,
+                                        fmin, ratio, reset_total, stick);
   } else if (slipped) {
-    if (len3(D) != 0.0) {
-      // the force drops to Fmin along the trial force; eq. 8 resets the spring to hold
-      // Fmin alone, or with /total spring + dashpot (linear_history's rescale)
-      const double fmin = fncrit * kin;    // Fmin (eq. 8)
-      const double scale = magfs > 0.0 ? fmin * (1.0 / magfs) : 0.0;
-      const double back = -1.0 / ks;
-      for (int i = 0; i < 3; i++) {
-        D[i] = scale * F[i];
-        if (TOTAL) D[i] = D[i] + dv[i];
-        D[i] = back * D[i];
-        F[i] = scale * F[i];
-      }
+    if (lensq3(D) != 0.0) {
+      // the force drops to Fmin along the trial force (rescaled as the host's stock does)
+      scale3(magfs > 0.0 ? rescale_factor(gm, fmin, magfs) : 0.0, F);
+      StickSlipCore::reset(F, fdamp, ks, reset_total, D);
     } else {
-      // linear_history's rule: a zero spring (a new contact in a set-up evaluation) gets no
+      // as linear_history: a zero spring (a new contact in a set-up evaluation) gets no
       // tangential force when the dashpot alone reaches the threshold
-      F[0] = F[1] = F[2] = 0.0;
+      zero3(F);
     }
   }
 
   copy3(D, history);
   copy3(F, fs);
-  if (RECORD) {
+  if (record) {
     if (update) {
-      // docs/law.md "Energy": the work the contact received, -F_s.V_s dt, less the increase
-      // of the spring energy Ks |D|^2/2
-      history[HIST_WORK] += -dot3(F, v) * gm->dt - 0.5 * ks * (lensq3(D) - before2);
+      // the work the contact received, -F_s.V_s dt, less the increase of the spring's
+      // energy Ks |D|^2 / 2
+      history[HIST_WORK] += StickSlipCore::dissipated(F, v, gm->dt, ks, before2, lensq3(D));
       if (slipped) history[HIST_NSLIP] += 1.0;
     }
     history[HIST_FN] = gm->Fntot;
     copy3(F, &history[HIST_FS]);
-    if (gm->calculate_svector) report_record(history);    // (walls with per-atom output)
+    if (gm->calculate_svector) report_record(history);
   }
 }
-
-/* ---------------------------------------------------------------------- */
-
-template <bool TOTAL, bool EXACT, bool RECORD>
-void GranSubModTangentialStickSlipWith<TOTAL, EXACT, RECORD>::calculate_forces()
-{
-  this->template step<TOTAL, EXACT, RECORD>();
-}
-
-// the eight names of the header
-namespace LAMMPS_NS {
-namespace Granular_NS {
-  template class GranSubModTangentialStickSlipWith<false, false, false>;
-  template class GranSubModTangentialStickSlipWith<false, false, true>;
-  template class GranSubModTangentialStickSlipWith<false, true, false>;
-  template class GranSubModTangentialStickSlipWith<false, true, true>;
-  template class GranSubModTangentialStickSlipWith<true, false, false>;
-  template class GranSubModTangentialStickSlipWith<true, false, true>;
-  template class GranSubModTangentialStickSlipWith<true, true, false>;
-  template class GranSubModTangentialStickSlipWith<true, true, true>;
-}    // namespace Granular_NS
-}    // namespace LAMMPS_NS

@@ -38,10 +38,10 @@ steps on 2 processes). On a busy machine everything is slower, and the rounds ad
 want of quiet blocks (up to 3 x) add to it.
 
     python -m stickslip.bench.liggghts [--rounds 5] [--reps 3] [--no-callgrind] [--baseline LAUNCHER]
-        [--control LAUNCHER] [--stamp-cost]
+        [--control [LAUNCHER]] [--stamp-cost]
 
---control: a control build's launcher (liggghts_plugin/control_stock_history.h: stock history
-compiled into the plugin) joins the rounds, so that the law is also compared with stock's
+--control: the control build (liggghts_variants.py: stock history compiled into the plugin in
+the law's place; built into build/liggghts_control, or give its launcher) joins the rounds, so that the law is also compared with stock's
 arithmetic built as the plugin is; --stamp-cost: stick_slip without its stamp joins them.
 """
 from __future__ import annotations
@@ -121,7 +121,7 @@ def benchmark(reps=3, rounds=ROUNDS, counts=True, baseline=None, stamp_cost=Fals
     """Rows for `stickslip bench` (see the module docstring). `baseline`: another build's
     launcher, whose stick_slip (both timings) joins the rounds and the counts, for A/B
     comparisons of two builds. `stamp_cost`: stick_slip without its stamp joins them too.
-    `control`: the launcher of a control build (liggghts_plugin/control_stock_history.h),
+    `control`: the launcher of the control build (liggghts_variants.py),
     whose `stick_slip` is stock history compiled into the plugin."""
     liggghts_runs.check()
     reps, rounds = max(1, int(reps)), max(1, int(rounds))
@@ -275,13 +275,18 @@ def main(argv=None):
     ap.add_argument("--reps", type=int, default=3, help="MPI repetitions (median quoted)")
     ap.add_argument("--no-callgrind", action="store_true", help="skip the instruction counts")
     ap.add_argument("--baseline", type=Path, help="another build's liggghts-stickslip, compared in the same rounds")
-    ap.add_argument("--control", type=Path, help="a control build's liggghts-stickslip (liggghts_plugin/"
-                    "control_stock_history.h): stock history compiled in the plugin, in the same rounds")
+    ap.add_argument("--control", type=Path, nargs="?", const=True,
+                    help="the control build's liggghts-stickslip (liggghts_variants.py: stock history compiled in "
+                         "the plugin; without a value it is built), in the same rounds")
     ap.add_argument("--stamp-cost", action="store_true",
                     help="also run stick_slip with history_on_separation keep (no stamp history value)")
     a = ap.parse_args(argv)
     if a.rounds < 1 or a.reps < 1:
         ap.error("--rounds and --reps must be >= 1")
+    if a.control is True:
+        from . import liggghts_variants
+
+        a.control = liggghts_variants.build("control")
     for opt, path in (("--baseline", a.baseline), ("--control", a.control)):
         if path is not None and not path.is_file():
             ap.error(f"{opt} {path}: no such file (a built liggghts-stickslip)")

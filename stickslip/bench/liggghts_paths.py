@@ -2,9 +2,9 @@
 """Where the stick_slip plugin's cost goes per contact-step, on the benchmark pour of
 liggghts_bench (issue 32), next to stock `tangential history` on the same contacts:
 
-1. how often each path through the law runs: an analysis build of the plugin
-   (cmake -DSTICK_SLIP_PATH_COUNTS=ON, into build/liggghts_plugin_paths; never the
-   default) counts them; the count over the benchmark's callgrind window (steps WARM to
+1. how often each path through the law runs: an analysis build of the plugin counts them
+   (liggghts_variants.py: the law and its core with a counter on each path, into
+   build/liggghts_plugin_paths; never the default); the count over the benchmark's callgrind window (steps WARM to
    WARM + STEPS) is the count of a run to the window's end less that of a run to its start;
 2. how many instructions each path executes: callgrind profiles the default build over
    the same steps with one count per instruction (--dump-instr=yes). An instruction of the
@@ -30,22 +30,15 @@ import tempfile
 from pathlib import Path
 
 from ..adapters.liggghts import BUILD, LAUNCHER
-from . import callgrind, liggghts_runs
+from . import callgrind, liggghts_runs, liggghts_variants
 from .liggghts import CALLGRIND_STEPS
 
-PATHS_BUILD = BUILD.parent / "liggghts_plugin_paths"
-LAW = re.compile(r"ContactModels::TangentialModel<\d+>::(surfacesIntersect|law<)|ContactModels::StickSlip::")
+LAW = re.compile(r"ContactModels::TangentialModel<\d+>::(surfacesIntersect|law<)|StickSlipCore::")
 
 
 def _analysis_build():
-    """The plugin built with the path counters (configured and built once, then kept)."""
-    src = Path(__file__).resolve().parents[2] / "liggghts_plugin"
-    if not (PATHS_BUILD / "CMakeCache.txt").is_file():
-        subprocess.run(["cmake", "-S", str(src), "-B", str(PATHS_BUILD), "-DCMAKE_BUILD_TYPE=Release",
-                        "-DSTICK_SLIP_PATH_COUNTS=ON"], check=True, stdout=subprocess.DEVNULL)
-    subprocess.run(["cmake", "--build", str(PATHS_BUILD), "-j", str(os.cpu_count() or 1)], check=True,
-                   stdout=subprocess.DEVNULL)
-    return PATHS_BUILD / "liggghts-stickslip"
+    """The plugin with the path counters (liggghts_variants: built once, again when the law changes)."""
+    return liggghts_variants.build("paths")
 
 
 def path_counts(tang, steps, work):
