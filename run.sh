@@ -11,6 +11,12 @@
 # Debian's source packages, once, cached in build/ (a second set-up costs seconds):
 #   lammps-2025      LAMMPS 4 Feb 2025 (Debian 13's source) with the tangential sub-model
 #                    stick_slip compiled in: build/lammps_2025/build/lmp (~3 min on 2 cores)
+#   lammps-2026      LAMMPS 4 Jul 2026 (Debian sid's source) with tools/lammps_patch.py's patch
+#                    applied, LAMMPS' own granular and pair-style test programs, and LAMMPS'
+#                    documentation packages (PyPI) for tools/lammps_docs.py:
+#                    build/lammps_2026/build/lmp (~7 min on 2 cores)
+#   lammps-2026-bigbig  the same tree built again with 64-bit atom and image ids
+#                    (LAMMPS_SIZES=BIGBIG): build/lammps_2026/bigbig/lmp (~3 min)
 #   liggghts-public  LIGGGHTS-PUBLIC 3.8.0 (Debian 12's source) with tangential stick_slip
 #                    built in by `make auto`: build/liggghts_public/source/src/lmp_auto (~7 min)
 set -euo pipefail
@@ -129,39 +135,159 @@ fetch_debian_source() {
     fi
 }
 
-setup_lammps_2025() {
-    # LAMMPS 4 Feb 2025 from Debian 13's source (132 MB, downloaded once), the smallest build
-    # that serves: core + GRANULAR + PLUGIN, MPI (Debian 12's OpenMPI), shared library, with
-    # lammps_plugin/granular/ copied into src/GRANULAR/ as a user would. Sources whose copy
+# The modern LAMMPS releases Debian carries, each built from its source package behind the
+# switch (its word), the same minimal build: core + GRANULAR + PLUGIN, MPI (Debian 12's
+# OpenMPI), shared library, with lammps_plugin/granular/ copied into src/GRANULAR/ as a user
+# would. word: Debian suite, source version, folder under build/.
+LAMMPS_RELEASES="lammps-2025:trixie:20250204+dfsg.1-2:lammps_2025 lammps-2026:sid:20260704+dfsg-2:lammps_2026"
+
+setup_lammps_release() {
+    # setup_lammps_release WORD: the release's source (downloaded once: 132 MB for 2025, 214 MB
+    # for 2026), extracted without what no build here reads; then cmake. 4 Feb 2025 takes
+    # lammps_plugin/granular/ copied into src/GRANULAR/ as a user would: sources whose copy
     # changed are copied again and rebuilt (cmake reconfigures: the sub-model registry is
-    # generated at configure time).
-    wants_source_build lammps-2025 || return 0
-    local top=build/lammps_2025 version=20250204+dfsg.1-2 src
+    # generated at configure time). 4 Jul 2026 takes the sub-model as a pull request would, by
+    # tools/lammps_patch.py's patch (patch_lammps_tree: with its documentation, example and
+    # unit-test cases), and also builds LAMMPS' own granular and pair-style tests (unittest/,
+    # ENABLE_TESTING) with Debian's googletest and libyaml (LAMMPS' CMake would download
+    # googletest). Times on 2 cores, first build: 2025 2.5 min; 2026 3 min, its tests 4 min.
+    local word=$1 entry suite version top src testing=0
+    entry=$(tr ' ' '\n' <<< "$LAMMPS_RELEASES" | grep "^$word:") || return 1
+    IFS=: read -r _ suite version top <<< "$entry"
+    top=build/$top
     src=$top/source
+    [ "$word" = lammps-2026 ] && testing=1
     if [ ! -f "$src/.complete" ]; then
-        echo "setup: LAMMPS 4 Feb 2025 from Debian 13's source (first time: ~3 min on 2 cores)"
-        fetch_debian_source trixie lammps "$version" "$top/download"
+        echo "setup: LAMMPS ${version%%+*} from Debian's source ($suite; first time: minutes on 2 cores)"
+        fetch_debian_source "$suite" lammps "$version" "$top/download"
         rm -rf "$src" && mkdir -p "$src"
-        tar -xJf "$top"/download/lammps_*.orig.tar.xz -C "$src" --strip-components=1 \
-            --exclude='*/examples' --exclude='*/doc' --exclude='*/potentials' --exclude='*/bench' \
-            --exclude='*/unittest' --exclude='*/tools' --exclude='*/python' --exclude='*/lib'
+        if [ "$testing" = 1 ]; then
+            # LAMMPS' tests read examples/plugins, examples/COUPLE, fortran/ and python/
+            tar -xf "$top"/download/lammps_*.orig.tar.* -C "$src" --exclude=doc/html
+        else
+            tar -xf "$top"/download/lammps_*.orig.tar.* -C "$src" --exclude=examples --exclude=doc \
+                --exclude=potentials --exclude=bench --exclude=tools --exclude=python --exclude=lib \
+                --exclude=fortran --exclude=unittest
+        fi
+        # (2025's tarball has its files in one folder, 2026's at the top)
+        if [ ! -d "$src/src" ]; then
+            local inner=("$src"/*/)
+            mv "${inner[0]}"* "$src"/ && rmdir "${inner[0]}"
+        fi
         echo "$version" > "$src/.complete"
     fi
     local changed=0 f
-    for f in lammps_plugin/granular/*; do
-        cmp -s "$f" "$src/src/GRANULAR/${f##*/}" || { cp "$f" "$src/src/GRANULAR/"; changed=1; }
-    done
+    if [ "$testing" = 0 ]; then
+        for f in lammps_plugin/granular/*; do
+            cmp -s "$f" "$src/src/GRANULAR/${f##*/}" || { cp "$f" "$src/src/GRANULAR/"; changed=1; }
+        done
+    else
+        patch_lammps_tree "$top" && changed=1
+    fi
+    local options=()
+    if [ "$testing" = 1 ]; then
+        # Debian's googletest sources (package googletest) as the archive LAMMPS' CMake would
+        # download: it takes a file already in _deps/ whose SHA-256 matches the one it is given
+        install_packages googletest libyaml-dev
+        mkdir -p "$top/build/_deps"
+        local gtest="$top/build/_deps/googletest-debian.tar.gz"
+        [ -f "$gtest" ] || tar -czf "$gtest" -C /usr/src googletest
+        options=(-D ENABLE_TESTING=on -D "GTEST_URL=file://$PWD/$gtest"
+                 -D "GTEST_SHA256=$(sha256sum "$gtest" | cut -d' ' -f1)")
+    fi
     if [ ! -f "$top/build/CMakeCache.txt" ] || [ "$changed" = 1 ]; then
         cmake -S "$src/cmake" -B "$top/build" -C "$src/cmake/presets/all_off.cmake" -D PKG_GRANULAR=on \
               -D PKG_PLUGIN=on -D BUILD_MPI=on -D BUILD_SHARED_LIBS=on -D LAMMPS_EXCEPTIONS=on \
-              -D BUILD_OMP=off -D CMAKE_BUILD_TYPE=Release >/dev/null
+              -D BUILD_OMP=off -D CMAKE_BUILD_TYPE=Release "${options[@]}" >/dev/null
     fi
-    cmake --build "$top/build" -j "$(nproc)" >/dev/null
-    # the legacy pair style gran/hooke/stickslip as a plugin of it (`plugin load`; lammps_plugin/
-    # lammps2025.cmake; ~10 s the first time on 2 cores, relinked when liblammps changes)
+    cmake --build "$top/build" -j "$(nproc)" --target lmp >/dev/null
+    if [ "$testing" = 1 ]; then
+        # only the test programs the sub-model needs (all of LAMMPS' would take far longer)
+        cmake --build "$top/build" -j "$(nproc)" --target $(lammps_test_programs) >/dev/null
+    fi
+}
+
+patch_lammps_tree() {
+    # patch_lammps_tree TOP: the sub-model enters 4 Jul 2026's tree as a pull request would:
+    # tools/lammps_patch.py's patch (sources, documentation, example, unit-test cases), written
+    # against pristine copies of the files it changes (TOP/pristine, kept from the source) and
+    # applied with patch(1); a changed patch first takes the previous one out again (patch -R).
+    # Returns 0 when the tree changed.
+    local top=$1 src=$1/source f applied=$1/source/.stick_slip.patch
+    if [ ! -f "$applied" ]; then
+        rm -rf "$top/pristine"
+        for f in $(.venv/bin/python tools/lammps_patch.py --changed); do
+            mkdir -p "$top/pristine/$(dirname "$f")" && cp "$src/$f" "$top/pristine/$f"
+        done
+    fi
+    .venv/bin/python tools/lammps_patch.py "$top/pristine" -o "$top/stick_slip.patch"
+    cmp -s "$top/stick_slip.patch" "$applied" && return 1
+    [ -f "$applied" ] && patch -d "$src" -p1 -R -s -f < "$applied" >/dev/null
+    patch -d "$src" -p1 -s --dry-run < "$top/stick_slip.patch" >/dev/null
+    patch -d "$src" -p1 -s < "$top/stick_slip.patch" >/dev/null
+    cp "$top/stick_slip.patch" "$applied"
+    return 0
+}
+
+setup_lammps_docs() {
+    # LAMMPS' documentation packages (its doc/utils/requirements.txt, from PyPI; the GitHub fork
+    # of sphinx-fortran as PyPI's: tools/lammps_docs.py) and the spelling builder's enchant
+    # library and dictionary, for tools/lammps_docs.py (~1 min the first time)
+    local venv=build/lammps_docs/venv want
+    install_packages libenchant-2-2 hunspell-en-us clang-format
+    want=$(.venv/bin/python tools/lammps_docs.py build/lammps_2026/source --requirements | sha256sum | cut -d' ' -f1)
+    [ -f "$venv/.requirements" ] && [ "$(cat "$venv/.requirements")" = "$want" ] && return 0
+    [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+    .venv/bin/python tools/lammps_docs.py build/lammps_2026/source --requirements > build/lammps_docs/requirements.txt
+    "$venv/bin/python" -m pip install -q --retries 10 -r build/lammps_docs/requirements.txt
+    echo "$want" > "$venv/.requirements"
+}
+
+lammps_test_programs() {
+    # LAMMPS' granular tests (test_dem_01 ... test_dem_11) and the pair-style tester
+    local n
+    for n in 01 02 03 04 05 06 07 08 09 10 11; do printf 'test_dem_%s ' "$n"; done
+    echo test_pair_style
+}
+
+install_packages() {
+    # install_packages PACKAGE...: Debian packages a source build needs (as root), or say which
+    local p missing=()
+    for p in "$@"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "ok installed" || missing+=("$p")
+    done
+    [ ${#missing[@]} -eq 0 ] && return 0
+    if [ "$(id -u)" -ne 0 ]; then
+        echo "setup: please run: sudo apt-get install ${missing[*]}" >&2
+        return 1
+    fi
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
+}
+
+setup_lammps_modern() {
+    local entry word
+    for entry in $LAMMPS_RELEASES; do
+        word=${entry%%:*}
+        wants_source_build "$word" && setup_lammps_release "$word"
+    done
+    if wants_source_build lammps-2026-bigbig; then
+        wants_source_build lammps-2026 || setup_lammps_release lammps-2026
+        # the patched tree again, built with LAMMPS' 64-bit sizes (lmp only)
+        [ -f build/lammps_2026/bigbig/CMakeCache.txt ] || \
+            cmake -S build/lammps_2026/source/cmake -B build/lammps_2026/bigbig \
+                  -C build/lammps_2026/source/cmake/presets/all_off.cmake -D PKG_GRANULAR=on -D BUILD_MPI=on \
+                  -D LAMMPS_SIZES=BIGBIG -D BUILD_OMP=off -D CMAKE_BUILD_TYPE=Release >/dev/null
+        cmake --build build/lammps_2026/bigbig -j "$(nproc)" --target lmp >/dev/null
+    fi
+    wants_source_build lammps-2026 && setup_lammps_docs
+    wants_source_build lammps-2025 || return 0
+    # the legacy pair style gran/hooke/stickslip as a plugin of LAMMPS 2025 (`plugin load`;
+    # lammps_plugin/lammps2025.cmake; ~10 s the first time on 2 cores, relinked when liblammps
+    # changes)
     [ -f build/lammps_2025_plugin/CMakeCache.txt ] || \
         cmake -S lammps_plugin -B build/lammps_2025_plugin -DCMAKE_BUILD_TYPE=Release \
-              -DLAMMPS_2025_DIR="$PWD/$top" >/dev/null
+              -DLAMMPS_2025_DIR="$PWD/build/lammps_2025" >/dev/null
     cmake --build build/lammps_2025_plugin -j "$(nproc)" >/dev/null
 }
 
@@ -174,16 +300,18 @@ wheel_check() {
 
 setup_liggghts_public() {
     # LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (6.5 MB, downloaded once), built as its users
-    # build it: liggghts_plugin/tangential_model_stick_slip.h copied into src/ and LIGGGHTS' own
+    # build it: liggghts_plugin/tangential_model_stick_slip.h and the law's core
+    # (lammps_plugin/granular/stick_slip_core.h) copied into src/ and LIGGGHTS' own
     # `make auto` (MPI with Debian 12's OpenMPI; VTK, JPG and superquadrics off, as none is needed
     # and Debian's library has no superquadrics), with stick_slip compiled in for the 40
     # combinations LIGGGHTS compiles for tangential history (src/style_contact_model_user.whitelist).
     # Executable: build/liggghts_public/source/src/lmp_auto; 6.6 min on 2 cores (8 min of CPU),
-    # once. A changed header is copied again and make rebuilds what includes it (1.5 min);
+    # once. A changed header is copied again and make rebuilds what includes them (1.5 min);
     # unchanged, a set-up costs nothing here. The source predates GNU make 4.3 and GCC 11: the
     # four fixes below and MPI_LIB_USR in Makefile.user let Debian 12 build it.
     wants_source_build liggghts-public || return 0
     local top=build/liggghts_public version=3.8.0+repack1-9 src header=tangential_model_stick_slip.h
+    local core=lammps_plugin/granular/stick_slip_core.h
     src=$top/source/src
     if [ ! -f "$top/source/.complete" ]; then
         echo "setup: LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (first time: ~7 min on 2 cores)"
@@ -206,13 +334,16 @@ setup_liggghts_public() {
         tail -n +11 "$src/MAKE/Makefile.user_default" | sed -e 's/^USE_VTK = "ON"/USE_VTK = "OFF"/' \
             -e 's/^USE_SUPERQUADRICS = "ON"/USE_SUPERQUADRICS = "OFF"/' \
             -e "s|^#MPI_LIB_USR=.*|MPI_LIB_USR=$(mpicxx --showme:libdirs)|" > "$src/MAKE/Makefile.user"
-        cp "liggghts_plugin/$header" "$src/"
+        cp "liggghts_plugin/$header" "$core" "$src/"
         (cd "$src" && bash Make.sh models >/dev/null)
         sed -n 's/TANGENTIAL_HISTORY/TANGENTIAL_STICK_SLIP/p' "$src/style_contact_model.whitelist" \
             > "$src/style_contact_model_user.whitelist"
         echo "$version" > "$top/source/.complete"
     fi
-    cmp -s "liggghts_plugin/$header" "$src/$header" || { cp "liggghts_plugin/$header" "$src/"; rm -f "$src/lmp_auto"; }
+    local f
+    for f in "liggghts_plugin/$header" "$core"; do
+        cmp -s "$f" "$src/${f##*/}" || { cp "$f" "$src/"; rm -f "$src/lmp_auto"; }
+    done
     [ -x "$src/lmp_auto" ] && return 0
     (cd "$src" && make auto -j "$(nproc)" >../../make.log 2>&1) || {
         echo "setup: LIGGGHTS' make auto failed (build/liggghts_public/make.log):" >&2
@@ -226,7 +357,7 @@ setup() {
     setup_python
     setup_plugin
     setup_lammps_plugin
-    setup_lammps_2025
+    setup_lammps_modern
     setup_liggghts_public
 }
 

@@ -59,6 +59,27 @@ def skip_engine(name, why=None):
     pytest.skip(f"{ENGINE_SKIP}: {name}: {why}")
 
 
+def lammps_releases():
+    """The modern LAMMPS releases a test runs on, one pytest parameter each (the adapter
+    lammps_granular's RELEASES; the override alone when STICKSLIP_LAMMPS_GRANULAR is set)."""
+    from stickslip.adapters import lammps_granular
+
+    return ["override"] if lammps_granular.OVERRIDE else list(lammps_granular.RELEASES)
+
+
+def lammps_release_launcher(release):
+    """Inside a test: the release's lmp, or skip where it is not built; as root a release that
+    the set-up switch asked for and that is missing is a failure."""
+    from stickslip.adapters import lammps_granular, source_build_asked
+
+    why = lammps_granular.release_missing(release)
+    if why is None:
+        return lammps_granular.built()[release]
+    if as_root() and source_build_asked(release):
+        pytest.fail(f"lammps_granular: {why}", pytrace=False)
+    pytest.skip(f"{ENGINE_SKIP}: lammps_granular: {why}")
+
+
 def pytest_configure(config):
     if hasattr(config, "workerinput") or not as_root():  # (xdist workers: the controller checks)
         return

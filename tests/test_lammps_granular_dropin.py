@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The tangential sub-model `stick_slip` (lammps_plugin/granular/) as a drop-in for LAMMPS
-2025's own sub-models: with mu_k = mu_s and /total its step-timing arithmetic is
-linear_history's operation for operation (with Ks NULL mindlin's), so
+"""The tangential sub-model `stick_slip` (lammps_plugin/granular/) as a drop-in for each modern
+LAMMPS release's own sub-models (every test runs on each release built here: 4 Feb 2025 and
+4 Jul 2026, whose stock sub-models differ in their arithmetic): with mu_k = mu_s and /total
+its step-timing arithmetic is that release's linear_history operation for operation (with
+Ks NULL its mindlin's), so
 `tangential stick_slip/total Ks x mu mu` must give `tangential linear_history Ks x mu`'s run
 bit for bit, and `stick_slip/total NULL x mu mu` gives `mindlin NULL x mu`'s, whatever the
 normal, damping, rolling and twisting sub-models around it, in pair_style granular and in
@@ -27,14 +29,18 @@ three runs), the 2-rank ones 1.3-2.8 s: 14-17 s for the module (~7 s CPU); up to
 import numpy as np
 import pytest
 
-from conftest import needs_engine
+from conftest import lammps_release_launcher, lammps_releases, needs_engine
 from lammps_runs import read_dump, run_lammps
-from stickslip.adapters import lammps_granular
 
-pytestmark = needs_engine("lammps_granular")  # LAMMPS 2025 built with the sub-model
+pytestmark = needs_engine("lammps_granular")  # a modern LAMMPS built with the sub-model
 
-LMP = lammps_granular.LAUNCHER  # (STICKSLIP_LAMMPS_2025: another build, e.g. a patched copy)
 STEPS, EVERY = 3000, 1000
+
+
+@pytest.fixture(params=lammps_releases())
+def lmp(request):
+    """The release's lmp (STICKSLIP_LAMMPS_GRANULAR: another build, e.g. a patched tree)."""
+    return lammps_release_launcher(request.param)
 
 # the normal model and its damping for each type (E, damping, nu), and the tangential
 # coefficients (Ks, x, mu_s) of each type: the 1-2 pairs mix them
@@ -60,13 +66,14 @@ def mindlin_ours(ks, x, mu, mu_k=None, name="stick_slip/total"):
     return f"{name} NULL {x:g} {mu:g} {mu if mu_k is None else mu_k:g}"
 
 
-def models(tangential, normal=HERTZ, extra=EXTRA, wall_tangential=None):
+def models(tangential, normal=HERTZ, extra=EXTRA, wall_tangential=None, pair_extra=""):
     """The granular model's words: (type 1's, type 2's, the walls'). tangential(ks, x, mu)
     -> the tangential sub-model's words for one set of coefficients; normal: each type's
     normal and damping words; extra: rolling/twisting words and keywords after the
-    tangential ones; wall_tangential: the walls' tangential words (default: tangential)."""
+    tangential ones; wall_tangential: the walls' tangential words (default: tangential);
+    pair_extra: keywords of pair_coeff alone (synchronized_verlet)."""
     wall_tangential = wall_tangential or tangential
-    pair = [f"{normal[t]} tangential {tangential(*TANGENTIAL[t])} {extra}" for t in (0, 1)]
+    pair = [f"{normal[t]} tangential {tangential(*TANGENTIAL[t])} {extra} {pair_extra}" for t in (0, 1)]
     return pair[0], pair[1], f"{normal[0]} tangential {wall_tangential(*WALL_TANGENTIAL)} {extra}"
 
 
@@ -96,16 +103,20 @@ pair_coeff 2 2 {words[1]}
 """
 
 
-def fixes(words, record=False):
+def fixes(words, record=False, moving=False):
     """What a restart file does not hold: integration, gravity, the floor (fix wall/gran
     granular zplane) and the side walls (fix wall/gran/region granular on a block region:
     regions are not kept in restart files either); record: the walls
-    keep per-atom contact values (`contacts`: columns 9-14 are the sub-model's record)."""
+    keep per-atom contact values (`contacts`: columns 9-14 are the sub-model's record);
+    moving: the side walls move, back and forth along y (0.05 at a period of 0.5)."""
     contacts = " contacts" if record else ""
+    side = "region side block INF INF -3 3 INF INF side in units box"
+    if moving:
+        side = f"variable dy equal 0.05*sin(2*PI*step*dt/0.5)\n{side} move NULL v_dy NULL"
     return f"""fix 1 all nve/sphere
 fix 2 all gravity 1.0 vector 0.45 0 -1
 fix floor all wall/gran granular {words[2]} zplane 0.0 NULL{contacts}
-region side block INF INF -3 3 INF INF side in units box
+{side}
 fix side all wall/gran/region granular {words[2]} region side{contacts}
 """
 
@@ -134,10 +145,11 @@ dump_modify walls sort id format float %.17g
     return s
 
 
-def scene(tangential, normal=HERTZ, extra=EXTRA, newton="off", wall_tangential=None, record=False):
+def scene(tangential, normal=HERTZ, extra=EXTRA, newton="off", wall_tangential=None, record=False, pair_extra="",
+          moving=False):
     """The whole run, STEPS steps (the module's docstring)."""
-    words = models(tangential, normal, extra, wall_tangential)
-    return pile(words, newton) + fixes(words, record) + output(record=record) + f"run {STEPS}\n"
+    words = models(tangential, normal, extra, wall_tangential, pair_extra)
+    return pile(words, newton) + fixes(words, record, moving) + output(record=record) + f"run {STEPS}\n"
 
 
 def thermo_text(log):
@@ -147,10 +159,18 @@ def thermo_text(log):
     return text[start:text.index("\nLoop time", start)]
 
 
-def run(tmp_path, name, script, np_=1):
+def run(tmp_path, name, script, lmp, np_=1):
     work = tmp_path / name
-    run_lammps(work, name, script, exe=LMP, np_=np_)
+    run_lammps(work, name, script, exe=lmp, np_=np_)
     return work
+
+
+def lammps_version(work):
+    """The release that made a run, from its log's first line: (year, month, day)."""
+    import datetime
+
+    first = (work / f"log.{work.name}").read_text().split("\n", 1)[0]  # LAMMPS (4 Feb 2025)
+    return datetime.datetime.strptime(first[first.index("(") + 1:first.index(")")].split(" - ")[0], "%d %b %Y").date()
 
 
 def assert_same_run(a, b):
@@ -165,13 +185,13 @@ def assert_same_run(a, b):
 
 
 @pytest.mark.parametrize("np_,newton", [(1, "off"), (1, "on"), (2, "off"), (2, "on")])
-def test_stick_slip_total_is_linear_history_bit_for_bit(tmp_path, np_, newton):
+def test_stick_slip_total_is_linear_history_bit_for_bit(tmp_path, np_, newton, lmp):
     """Hertz with viscoelastic damping and limit_damping, pair and both walls: stock
     linear_history and stick_slip/total with mu_k = mu_s give the same bytes, serial and
     on 2 ranks (split along x: the flow carries grains and contacts across the ranks'
     boundary and the periodic one), newton on and off."""
-    stock = run(tmp_path, "stock", scene(stock_words, newton=newton), np_)
-    ours = run(tmp_path, "ours", scene(ours_words, newton=newton), np_)
+    stock = run(tmp_path, "stock", scene(stock_words, newton=newton), lmp, np_)
+    ours = run(tmp_path, "ours", scene(ours_words, newton=newton), lmp, np_)
     assert_same_run(stock, ours)
 
 
@@ -193,32 +213,44 @@ VARIANTS = {
 
 
 @pytest.mark.parametrize("variant", sorted(VARIANTS))
-def test_any_normal_damping_rolling_and_twisting(tmp_path, variant):
+def test_any_normal_damping_rolling_and_twisting(tmp_path, variant, lmp):
     """The same drop-in with other normal, damping, rolling and twisting sub-models."""
     normal, extra, np_, newton = VARIANTS[variant]
-    stock = run(tmp_path, "stock", scene(stock_words, normal, extra, newton), np_)
-    ours = run(tmp_path, "ours", scene(ours_words, normal, extra, newton), np_)
+    stock = run(tmp_path, "stock", scene(stock_words, normal, extra, newton), lmp, np_)
+    ours = run(tmp_path, "ours", scene(ours_words, normal, extra, newton), lmp, np_)
     assert_same_run(stock, ours)
 
 
-def test_ks_null_is_mindlin_bit_for_bit(tmp_path):
+def test_moving_region_wall_with_tsuji_damping(tmp_path, lmp):
+    """The side walls move back and forth (a moving region of fix wall/gran/region granular:
+    its contacts take the wall's velocity), tsuji damping, rolling and twisting: stick_slip/total
+    is linear_history's run, and with Ks NULL mindlin's, on 2 ranks newton off."""
+    normal = ("hertz/material 1e4 0.6 0.3 damping tsuji", "hertz/material 2e4 0.5 0.25 damping tsuji")
+    extra = "rolling sds 200 20 0.1 twisting marshall"
+    for stock_tangential, ours_tangential in ((stock_words, ours_words), (mindlin_stock, mindlin_ours)):
+        stock = run(tmp_path, "stock", scene(stock_tangential, normal, extra, moving=True), lmp, 2)
+        ours = run(tmp_path, "ours", scene(ours_tangential, normal, extra, moving=True), lmp, 2)
+        assert_same_run(stock, ours)
+
+
+def test_ks_null_is_mindlin_bit_for_bit(tmp_path, lmp):
     """Ks NULL (Mindlin's 8 G* a from the material of hertz/material) against `mindlin NULL x
     mu`, newton on; mixed types take 8 G* of the mixed material, as mindlin."""
-    stock = run(tmp_path, "stock", scene(mindlin_stock, newton="on"))
-    ours = run(tmp_path, "ours", scene(mindlin_ours, newton="on"))
+    stock = run(tmp_path, "stock", scene(mindlin_stock, newton="on"), lmp)
+    ours = run(tmp_path, "ours", scene(mindlin_ours, newton="on"), lmp)
     assert_same_run(stock, ours)
 
 
-def test_the_walls_alone_are_a_drop_in(tmp_path):
+def test_the_walls_alone_are_a_drop_in(tmp_path, lmp):
     """The floor (fix wall/gran granular zplane) and the side walls (fix wall/gran/region
     granular) with stick_slip/total, the grain pairs with linear_history in both runs:
     the walls' contacts alone give stock's bytes."""
-    stock = run(tmp_path, "stock", scene(stock_words))
-    ours = run(tmp_path, "ours", scene(stock_words, wall_tangential=ours_words))
+    stock = run(tmp_path, "stock", scene(stock_words), lmp)
+    ours = run(tmp_path, "ours", scene(stock_words, wall_tangential=ours_words), lmp)
     assert_same_run(stock, ours)
 
 
-def test_the_scene_sticks_and_slips(tmp_path):
+def test_the_scene_sticks_and_slips(tmp_path, lmp):
     """What the drop-in tests compare is not equal by construction:
     - stick_slip/total/record with mu_k = mu_s is stock's run too (the record changes no
       force; its history is 9 values a contact, transferred with their own signs);
@@ -226,8 +258,8 @@ def test_the_scene_sticks_and_slips(tmp_path):
       floor and on the side walls, and contacts that stick: of the contacts open at two
       dumps 100 steps apart, some slipped in between and some did not;
     - mu_k = 0.9 mu_s, the law's own drop after a slip, gives another run."""
-    stock = run(tmp_path, "stock", scene(stock_words))
-    ours = run(tmp_path, "record", scene(lambda *c: ours_words(*c, name="stick_slip/total/record"), record=True))
+    stock = run(tmp_path, "stock", scene(stock_words), lmp)
+    ours = run(tmp_path, "record", scene(lambda *c: ours_words(*c, name="stick_slip/total/record"), record=True), lmp)
     assert_same_run(stock, ours)
 
     frames = read_dump(ours / "dump.contacts")
@@ -248,18 +280,68 @@ def test_the_scene_sticks_and_slips(tmp_path):
     assert slipped > 100 and stuck > 100
     assert walls[:, 5].sum() > 100 and walls[:, 11].sum() > 0
 
-    lower = run(tmp_path, "lower", scene(lambda ks, x, mu: ours_words(ks, x, mu, 0.9 * mu)))
+    lower = run(tmp_path, "lower", scene(lambda ks, x, mu: ours_words(ks, x, mu, 0.9 * mu)), lmp)
     assert (lower / "dump.atoms").read_bytes() != (stock / "dump.atoms").read_bytes()
 
 
-def test_linear_history_classic_scales_the_spring_by_the_contact_radius(tmp_path):
+# releases before synchronized verlet (pair granular's keyword synchronized_verlet)
+SYNCHRONIZED_SINCE = __import__("datetime").date(2025, 2, 5)
+
+
+def test_synchronized_verlet_is_linear_history_and_mindlin_bit_for_bit(tmp_path, lmp):
+    """pair_coeff's synchronized_verlet (LAMMPS after 4 Feb 2025; Vyas et al. 2025): the
+    spring is turned into the half step's tangent plane before it is loaded and into the
+    full step's after, and the dashpot's velocity with it, as linear_history and mindlin do
+    (the host's rotate_rescale_vec): stick_slip/total at mu_k = mu_s gives their bytes, on
+    2 ranks newton on (linear_history) and serial newton off (Ks NULL: mindlin). The walls
+    take no such keyword. Not equal by construction: the keyword changes stock's run."""
+    if not _synchronized(tmp_path, lmp):
+        pytest.skip("this release has no synchronized verlet")
+    sync = "synchronized_verlet"
+    stock = run(tmp_path, "stock", scene(stock_words, newton="on", pair_extra=sync), lmp, 2)
+    ours = run(tmp_path, "ours", scene(ours_words, newton="on", pair_extra=sync), lmp, 2)
+    assert_same_run(stock, ours)
+    plain = run(tmp_path, "plain", scene(stock_words, newton="on"), lmp, 2)
+    assert (plain / "dump.atoms").read_bytes() != (stock / "dump.atoms").read_bytes()
+    stock = run(tmp_path, "mindlin_stock", scene(mindlin_stock, pair_extra=sync), lmp)
+    ours = run(tmp_path, "mindlin_ours", scene(mindlin_ours, pair_extra=sync), lmp)
+    assert_same_run(stock, ours)
+
+
+def _synchronized(tmp_path, lmp):
+    """Whether this release has synchronized verlet (from the version its log states)."""
+    work = run(tmp_path, "version", "info system\n", lmp)
+    return lammps_version(work) >= SYNCHRONIZED_SINCE
+
+
+def test_exact_timing_refuses_synchronized_verlet(tmp_path, lmp):
+    """Exact timing integrates the spring along one tangent plane over the step, which
+    synchronized verlet turns twice within it: /exact refuses it in one ERROR line naming the
+    sub-model (LAMMPS' own check of allow_synchronization); step timing takes it."""
+    if not _synchronized(tmp_path, lmp):
+        pytest.skip("this release has no synchronized verlet")
+    from lammps_runs import error_lines
+
+    for name, fails in (("stick_slip/exact", True), ("stick_slip/total/exact/record", True), ("stick_slip", False)):
+        script = pile(models(lambda *c: ours_words(*c, name=name), pair_extra="synchronized_verlet")) + "run 0\n"
+        proc = run_lammps(tmp_path / "refuse", "refuse", script, exe=lmp, check=False)
+        errors = error_lines(proc)
+        if fails:
+            assert len(errors) == 1 and "synchronized verlet" in errors[0] and name in errors[0], proc.stdout[-2000:]
+        else:
+            assert proc.returncode == 0 and not errors, proc.stdout[-2000:]
+
+
+def test_linear_history_classic_and_the_classic_wall(tmp_path, lmp):
     """Why the reference is linear_history, not linear_history_classic: in LAMMPS 4 Feb 2025
     `linear_history_classic` (and with it the classic `fix wall/gran hooke/history`, which
-    LAMMPS now builds from it) multiplies Ks by the contact radius a = sqrt(delta R), unlike
-    pair gran/hooke/history and this LAMMPS' 29 Sep 2021 (Debian 12), whose walls give
-    linear_history's force. One grain (R 0.5) overlapping the floor by 1e-3 slides at
-    v = 1 along x, no rotation, no tangential dashpot: after one step (dt 1e-6) the spring
-    holds v dt and the floor's tangential force is -Ks v dt, or -Ks a v dt (a ~ 0.022)."""
+    LAMMPS builds from it) multiplies Ks by the contact radius a = sqrt(delta R), unlike
+    pair gran/hooke/history and Debian 12's LAMMPS (29 Sep 2021), whose walls give
+    linear_history's force; LAMMPS 4 Jul 2026 no longer scales it (its
+    linear_history_classic sets no contact-radius flag; mindlin_classic does). One grain
+    (R 0.5) overlapping the floor by 1e-3 slides at v = 1 along x, no rotation, no
+    tangential dashpot: after one step (dt 1e-6) the spring holds v dt and the floor's
+    tangential force is -Ks v dt, or -Ks a v dt (a ~ 0.022)."""
     v, dt, ks = 1.0, 1e-6, 200.0
     forces = {}
     granular = "granular hooke 1000 0 damping velocity tangential"
@@ -283,11 +365,12 @@ dump d all custom 1 dump.one id z f_w[2]
 dump_modify d format float %.17g
 run 1
 """
-        work = run(tmp_path, name.replace("/", "_"), script)
+        work = run(tmp_path, name.replace("/", "_"), script, lmp)
         forces[name] = read_dump(work / "dump.one")[1][0, 1:]
     z, fx = forces["linear_history"]
     assert fx == -ks * (v * dt)
     a = np.sqrt((0.5 - z) * 0.5)
+    scaled = lammps_version(work) < SYNCHRONIZED_SINCE  # (4 Feb 2025 and before)
     for name in ("classic", "hooke/history"):
         assert forces[name][0] == z
-        assert forces[name][1] == pytest.approx(-ks * a * (v * dt), rel=1e-12), name
+        assert forces[name][1] == pytest.approx(-ks * (a if scaled else 1.0) * (v * dt), rel=1e-12), name

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The contact history of the tangential sub-model `stick_slip` (lammps_plugin/granular/) in
-LAMMPS 2025 across processes and MPI ranks: through write_restart + read_restart, and
+each modern LAMMPS release across processes and MPI ranks: through write_restart + read_restart, and
 between the two bodies of a contact (the sub-model's history transfer factors).
 
 Restarts. "Exactly" means what it means in LAMMPS (tests/test_lammps_restart.py): a new `run`
@@ -55,9 +55,9 @@ import pytest
 
 from conftest import needs_engine
 from lammps_runs import read_dump, run_lammps
-from test_lammps_granular_dropin import LMP, fixes, models, ours_words, output, pile, stock_words, thermo_text
+from test_lammps_granular_dropin import fixes, lmp, models, ours_words, output, pile, stock_words, thermo_text  # noqa: F401
 
-pytestmark = needs_engine("lammps_granular")  # LAMMPS 2025 built with the sub-model
+pytestmark = needs_engine("lammps_granular")  # a modern LAMMPS built with the sub-model (each release: lmp)
 
 N1, N2, EVERY = 1500, 500, 100
 
@@ -107,7 +107,7 @@ def rows(path):
 
 
 @pytest.mark.parametrize("name,newton", [("stick_slip/record", "off"), ("stick_slip/total/exact/record", "on")])
-def test_restart_continues_every_contact(tmp_path, name, newton):
+def test_restart_continues_every_contact(tmp_path, name, newton, lmp):
     """2 ranks: the split run against write_restart + read_restart in a new process; the
     continued run's dumps (grains, pair records, wall records) and thermo output are the
     split run's bytes from the restart step on; the run that wrote the file (`write_restart
@@ -115,11 +115,11 @@ def test_restart_continues_every_contact(tmp_path, name, newton):
     read back at the restart step hold slips: pair, floor and side-wall contacts that have
     slipped before N1."""
     words = models(law(name))
-    run_lammps(tmp_path / "split", "split", split_run(words, newton), exe=LMP, np_=2)
-    run_lammps(tmp_path / "writer", "writer", split_run(words, newton, write_restart="noinit"), exe=LMP, np_=2)
+    run_lammps(tmp_path / "split", "split", split_run(words, newton), exe=lmp, np_=2)
+    run_lammps(tmp_path / "writer", "writer", split_run(words, newton, write_restart="noinit"), exe=lmp, np_=2)
     (tmp_path / "read").mkdir()
     (tmp_path / "read" / "restart.n1").write_bytes((tmp_path / "writer" / "restart.n1").read_bytes())
-    run_lammps(tmp_path / "read", "read", reader(words, newton), exe=LMP, np_=2)
+    run_lammps(tmp_path / "read", "read", reader(words, newton), exe=lmp, np_=2)
     for dump in ("dump.atoms", "dump.contacts", "dump.walls"):
         split = (tmp_path / "split" / dump).read_bytes()
         assert (tmp_path / "writer" / dump).read_bytes() == split, f"write_restart changed {dump}"
@@ -136,7 +136,7 @@ def test_restart_continues_every_contact(tmp_path, name, newton):
     assert pair_slipped > 50 and floor_slipped > 20 and side_slipped > 5
 
 
-def test_write_restart_needs_noinit_between_runs(tmp_path):
+def test_write_restart_needs_noinit_between_runs(tmp_path, lmp):
     """LAMMPS 4 Feb 2025, 2 ranks: a plain `write_restart` between two runs changes the
     run after it, with stock linear_history as with stick_slip. The command first inits
     the system and moves atoms between ranks (comm->exchange, comm->borders), then fix
@@ -150,7 +150,7 @@ def test_write_restart_needs_noinit_between_runs(tmp_path):
     the sub-model is stock through it); stock with `noinit` is stock without."""
     def run(name, tangential, write_restart):
         words = models(tangential)
-        run_lammps(tmp_path / name, name, split_run(words, "off", write_restart, record=False), exe=LMP, np_=2)
+        run_lammps(tmp_path / name, name, split_run(words, "off", write_restart, record=False), exe=lmp, np_=2)
         return (tmp_path / name / "dump.atoms").read_bytes()
 
     stock = run("stock", stock_words, None)
@@ -162,7 +162,7 @@ def test_write_restart_needs_noinit_between_runs(tmp_path):
     assert stock_noinit == stock
 
 
-def test_pair_granular_needs_its_style_again_after_read_restart(tmp_path):
+def test_pair_granular_needs_its_style_again_after_read_restart(tmp_path, lmp):
     """LAMMPS 4 Feb 2025: pair granular writes no global settings to a restart file and its
     constructor leaves the global cutoff unset, so after read_restart the pair style's
     cutoff is 0 (the log's "master list distance cutoff = 0": no ghost atoms, one
@@ -173,7 +173,7 @@ def test_pair_granular_needs_its_style_again_after_read_restart(tmp_path):
     style). The pile after 200 steps (serial), read on 2 ranks, `run 0`."""
     words = models(law("stick_slip/record"))
     writer = pile(words) + fixes(words) + "run 200\nwrite_restart restart.n1\n"
-    run_lammps(tmp_path / "write", "write", writer, exe=LMP)
+    run_lammps(tmp_path / "write", "write", writer, exe=lmp)
     count = {}
     for again in (False, True):
         work = tmp_path / f"read-{again}"
@@ -181,7 +181,7 @@ def test_pair_granular_needs_its_style_again_after_read_restart(tmp_path):
         (work / "restart.n1").write_bytes((tmp_path / "write" / "restart.n1").read_bytes())
         script = ("newton off\nread_restart restart.n1\n" + ("pair_style granular\n" if again else "")
                   + "neighbor 0.2 bin\n" + fixes(words, record=True) + output(record=True, record_every=1) + "run 0\n")
-        run_lammps(work, "read", script, exe=LMP, np_=2)
+        run_lammps(work, "read", script, exe=lmp, np_=2)
         count[again] = len(read_dump(work / "dump.contacts")[200])
         cutoff = "master list distance cutoff = 0\n" in (work / "log.read").read_text()
         assert cutoff != again, (again, "the pair style's cutoff")
@@ -250,7 +250,7 @@ run {DIMER_STEPS}
 """
 
 
-def test_the_record_is_the_same_seen_from_either_grain(tmp_path):
+def test_the_record_is_the_same_seen_from_either_grain(tmp_path, lmp):
     """The dimers on 1 rank (newton off: the reference; newton on) and on 2 ranks (newton
     off and on): every grain's state and every contact's record (Fn, F_s seen from the lower
     id, slips, work) identical at every 100th step; slip counts never fall. What was
@@ -262,7 +262,7 @@ def test_the_record_is_the_same_seen_from_either_grain(tmp_path):
         work = tmp_path / f"{np_}-{newton}"
         work.mkdir()
         (work / "dimers.data").write_text(dimers())
-        run_lammps(work, "dimers", dimer_script(newton), exe=LMP, np_=np_)
+        run_lammps(work, "dimers", dimer_script(newton), exe=lmp, np_=np_)
         runs[np_, newton] = work
     ref_dir = runs[1, "off"]
     ref = rows(ref_dir / "dump.contacts")

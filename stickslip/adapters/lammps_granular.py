@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""Adapter for LAMMPS as granular users build it today (2Aug2023 and later): `pair_style
-granular` and `fix wall/gran granular` with the tangential sub-model `stick_slip`
-(lammps_plugin/granular/, compiled into the LAMMPS 4 Feb 2025 that
-`STICKSLIP_SOURCE_BUILDS=lammps-2025 ./run.sh setup` builds from Debian 13's source).
+"""Adapter for LAMMPS as granular users build it today: `pair_style granular` and `fix
+wall/gran granular` with the tangential sub-model `stick_slip` (lammps_plugin/granular/),
+compiled into the modern LAMMPS releases that `./run.sh setup` builds from Debian's source
+behind its switch (RELEASES: `STICKSLIP_SOURCE_BUILDS=lammps-2025,lammps-2026`).
 
 The script is the LAMMPS adapter's (stickslip/adapters/lammps.py: grains, walls, gravity,
 integration, dumps) with the contact model in the granular syntax:
@@ -26,15 +26,44 @@ from pathlib import Path
 from .lammps import REPO, _Script, _fmt, run_with
 
 NAME = "lammps_granular"
-# The LAMMPS 2025 build (./run.sh setup with STICKSLIP_SOURCE_BUILDS=lammps-2025). Defined here
-# only; STICKSLIP_LAMMPS_2025 points it at another build (tools/mutate_cpp.py: a mutant's).
-BUILD = Path(os.environ.get("STICKSLIP_LAMMPS_2025") or REPO / "build" / "lammps_2025" / "build")
-LAUNCHER = BUILD / "lmp"
+# The releases ./run.sh builds (its LAMMPS_RELEASES): the switch's word -> (LAMMPS' version,
+# the build's folder under build/), oldest first. Defined here only.
+RELEASES = {"lammps-2025": ("4 Feb 2025", "lammps_2025"), "lammps-2026": ("4 Jul 2026", "lammps_2026")}
+# STICKSLIP_LAMMPS_GRANULAR: another LAMMPS build folder (tools/mutate_cpp.py: a mutant's; a
+# patched tree's), then the only release the adapter and the tests use.
+OVERRIDE = os.environ.get("STICKSLIP_LAMMPS_GRANULAR")
+
+
+def launcher(release):
+    """The `lmp` of a release (a word of RELEASES)."""
+    return REPO / "build" / RELEASES[release][1] / "build" / "lmp"
+
+
+def built():
+    """{release: its lmp} for the releases built here ({"override": its lmp} when
+    STICKSLIP_LAMMPS_GRANULAR is set)."""
+    if OVERRIDE:
+        return {"override": Path(OVERRIDE) / "lmp"}
+    return {r: launcher(r) for r in RELEASES if launcher(r).is_file()}
+
+
+# the newest release built here runs the scenes (the drop-in and restart tests run on each)
+LAUNCHER = next(reversed(built().values()), launcher(list(RELEASES)[-1]))
+
+
+def release_missing(release):
+    """None if the release is built here, else why not in one line."""
+    if OVERRIDE:
+        return None if release == "override" else f"STICKSLIP_LAMMPS_GRANULAR={OVERRIDE} replaces {release}"
+    if launcher(release).is_file():
+        return None
+    return f"{launcher(release)} missing (STICKSLIP_SOURCE_BUILDS={release} ./run.sh setup builds it)"
 
 
 def available():
     if not LAUNCHER.is_file():
-        return f"{LAUNCHER} missing (STICKSLIP_SOURCE_BUILDS=lammps-2025 ./run.sh setup builds LAMMPS 2025)"
+        return (f"{LAUNCHER} missing (STICKSLIP_SOURCE_BUILDS={','.join(RELEASES)} ./run.sh setup builds "
+                "the modern LAMMPS releases)")
     return None
 
 

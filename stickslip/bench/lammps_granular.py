@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""LAMMPS 2025 rows for `stickslip bench` (issue 49 item 5): what the tangential sub-model
+"""Modern LAMMPS rows for `stickslip bench`: what the tangential sub-model
 `stick_slip` of `pair_style granular` costs against LAMMPS' own `linear_history` (the same
 numeric Ks) and `mindlin` (Ks NULL on both: Mindlin's 8 G* a), on a settled bed of 10 368
 spheres, in both slip timings.
@@ -43,7 +43,8 @@ Cost on the 2-core machine: ~1 min of one core once for the bed; ~27 s a round (
 ~2.7 s timed, ~1.5 s of start and warm-up; 10 rounds by default), ~1.5 min of callgrind
 (two at a time): ~6 min in all (measured at load 2-4; the other processes' load slows it). (`stickslip bench` takes these rows; its `reps` has no use here: no MPI part.)
 
-    python -m stickslip.bench.lammps_granular [--rounds 10] [--steps 800] [--no-callgrind] [--callgrind-steps 100]
+    python -m stickslip.bench.lammps_granular [--release lammps-2026] [--rounds 10] [--steps 800] [--no-callgrind]
+                                              [--callgrind-steps 100]
 """
 from __future__ import annotations
 
@@ -55,7 +56,7 @@ import sys
 import tempfile
 import time
 
-from ..adapters.lammps_granular import LAUNCHER
+from ..adapters import lammps_granular
 from . import callgrind
 from . import lammps as base
 from .data_cache import cached_data
@@ -169,13 +170,23 @@ def label(config):
     return f"tangential {TANGENTIAL[config].split()[0]} (Ks {TANGENTIAL[config].split()[1]})"
 
 
-def _check():
-    if not LAUNCHER.is_file():
-        raise RuntimeError(f"LAMMPS 2025 not built: {LAUNCHER} missing "
-                           "(STICKSLIP_SOURCE_BUILDS=lammps-2025 ./run.sh setup)")
+def launcher(release=None):
+    """The lmp to time: a release of lammps_granular.RELEASES, or the newest built."""
+    if release is None:
+        return lammps_granular.LAUNCHER
+    why = lammps_granular.release_missing(release)
+    if why:
+        raise RuntimeError(why)
+    return lammps_granular.built()[release]
 
 
-def bed(size=BED, cache=CACHE):
+def _check(lmp):
+    if not lmp.is_file():
+        raise RuntimeError(f"LAMMPS not built: {lmp} missing (STICKSLIP_SOURCE_BUILDS="
+                           f"{','.join(lammps_granular.RELEASES)} ./run.sh setup)")
+
+
+def bed(size=BED, cache=CACHE, lmp=None):
     """The settled bed's data file (made once, kept in `cache`); size: grains along x, y and layers."""
     nx, ny, layers = size
     spacing = 1.2
@@ -184,7 +195,7 @@ def bed(size=BED, cache=CACHE):
 
     def make(tmp):
         (tmp / "in.settle").write_text(script)
-        base._run(_command("in.settle"), tmp)
+        base._run(_command("in.settle", lmp), tmp)
         return tmp / "bed.data"
     return cached_data(cache, f"bed-{nx}x{ny}x{layers}", script, make)
 
@@ -213,8 +224,8 @@ def bed_facts(data):
     return {"grains": len(mass), "ke_per_grain": ke / len(mass), "settle_steps": steps}
 
 
-def _command(infile="in.timed"):
-    return [str(LAUNCHER), "-in", infile, "-log", "none", "-echo", "none", "-nocite"]
+def _command(infile="in.timed", lmp=None):
+    return [str(lmp or lammps_granular.LAUNCHER), "-in", infile, "-log", "none", "-echo", "none", "-nocite"]
 
 
 def script(data, config, steps=STEPS, warm=WARM, before="", after=""):
@@ -222,42 +233,45 @@ def script(data, config, steps=STEPS, warm=WARM, before="", after=""):
     return TIMED.format(data=data, model=model(config), warm=warm, steps=steps, before=before, after=after)
 
 
-def _timed(data, config, work, steps, warm):
+def _timed(data, config, work, steps, warm, lmp):
     """One run: on-CPU seconds of the timed steps, pair contacts at their start (step 0) and
     end, the other processes' CPU during the run (cores)."""
     d = base._folder(work, f"timed-{config}")
     cpu, out, foreign = base.timed_run(d, script(data, config, steps, warm, "shell ./probe.sh", "shell ./probe.sh"),
-                                       _command(), PROBE)
+                                       _command(lmp=lmp), PROBE)
     return {"cpu": cpu, "contacts0": base._contacts(out, 0), "contacts": base._contacts(out, warm + steps),
             "foreign": foreign, "atoms": int(base.LOOP.findall(out)[-1][3])}
 
 
-def _counted(data, config, work, steps, warm):
+def _counted(data, config, work, steps, warm, lmp):
     d = base._folder(work, f"callgrind-{config}")
-    k = base.counted_run(d, script(data, config, steps, warm, "shell ./callgrind_on.sh"), _command(), GROUPS)
+    k = base.counted_run(d, script(data, config, steps, warm, "shell ./callgrind_on.sh"), _command(lmp=lmp), GROUPS)
     return dict(k, steps=steps)
 
 
 def measure(rounds=ROUNDS, counts=True, callgrind_steps=CALLGRIND_STEPS, size=BED, steps=STEPS, warm=WARM,
-            cache=CACHE, log=None):
+            cache=CACHE, log=None, release=None):
     """Every figure of the benchmark (a dict; rows() turns it into bench rows). `log`: a
-    function told of each finished round."""
-    _check()
+    function told of each finished round; release: the LAMMPS release to time (a word of
+    lammps_granular.RELEASES; None: the newest built)."""
+    lmp = launcher(release)
+    _check(lmp)
     t0 = time.monotonic()
-    data = bed(size, cache)
-    res = {"bed": bed_facts(data), "bed_s": time.monotonic() - t0, "steps": steps, "rounds": [], "counts": {}}
+    data = bed(size, cache, lmp)
+    res = {"bed": bed_facts(data), "bed_s": time.monotonic() - t0, "steps": steps, "rounds": [], "counts": {},
+           "release": release or next(r for r, x in lammps_granular.built().items() if x == lmp)}
     order = list(TANGENTIAL)
     with tempfile.TemporaryDirectory(prefix="lammps_granular_bench-") as work:
         for r in range(rounds):
             turn = order[r % len(order):] + order[:r % len(order)]
-            res["rounds"].append({c: _timed(data, c, work, steps, warm) for c in turn})
+            res["rounds"].append({c: _timed(data, c, work, steps, warm, lmp) for c in turn})
             if log:
                 log(f"round {r + 1}/{rounds}: "
                     + ", ".join(f"{c} {x['cpu']:.3f} s" for c, x in res["rounds"][-1].items()))
         t1 = time.monotonic()
         if counts and callgrind.available():
             with concurrent.futures.ThreadPoolExecutor(2) as pool:
-                jobs = {c: pool.submit(_counted, data, c, work, callgrind_steps, warm) for c in order}
+                jobs = {c: pool.submit(_counted, data, c, work, callgrind_steps, warm, lmp) for c in order}
                 res["counts"] = {c: j.result() for c, j in jobs.items()}
         res["callgrind_s"] = time.monotonic() - t1
     res["rounds_s"] = t1 - t0 - res["bed_s"]
@@ -270,7 +284,7 @@ def rows(res):
     rounds, b = res["rounds"], res["bed"]
     used, which = base.quiet_rounds(rounds)
     first = rounds[0]["linear_history"]
-    tag = f"settled bed's chute, {first['atoms']} grains, {res['steps']} steps, 1 process"
+    tag = f"LAMMPS {res['release']}, settled bed's chute, {first['atoms']} grains, {res['steps']} steps, 1 process"
     out.append({"benchmark": "lammps_granular", "case": f"the bed: grains / pair contacts per grain at read_data / "
                                                         f"kinetic energy per grain (LJ) / steps it settled in",
                 "value": f"{b['grains']} / {first['contacts0'] / first['atoms']:.2f} / {b['ke_per_grain']:.2g} / "
@@ -320,12 +334,13 @@ def main(argv=None):
     ap.add_argument("--steps", type=int, default=STEPS, help="timed steps per run")
     ap.add_argument("--no-callgrind", action="store_true")
     ap.add_argument("--callgrind-steps", type=int, default=CALLGRIND_STEPS, help="steps counted by callgrind")
+    ap.add_argument("--release", choices=list(lammps_granular.RELEASES), help="the LAMMPS to time (default: the newest built)")
     a = ap.parse_args(argv)
     if a.rounds < 1 or a.steps < 1 or a.callgrind_steps < 1:
         ap.error("--rounds, --steps and --callgrind-steps must be >= 1")
     try:
         res = measure(a.rounds, not a.no_callgrind, a.callgrind_steps, steps=a.steps,
-                      log=lambda text: print(text, file=sys.stderr, flush=True))
+                      log=lambda text: print(text, file=sys.stderr, flush=True), release=a.release)
     except RuntimeError as e:
         print(f"lammps_granular_bench: {e}", file=sys.stderr)
         return 1
