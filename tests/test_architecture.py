@@ -113,6 +113,16 @@ def test_benchmarks_and_studies_are_leaves():
                 assert name in ("stickslip.cli", "stickslip.report"), (name, dep)
 
 
+
+def test_the_contract_is_reached_from_tests_and_tools_only():
+    """stickslip/contract/ holds the law's contract and the drivers that hold each engine to it
+    (they use the adapters): nothing a run needs, so no module outside it imports it."""
+    g = graph()
+    assert "stickslip.contract.runners" in g and "stickslip.adapters.lammps" in g["stickslip.contract.lammps"]
+    for name, deps in g.items():
+        if not name.startswith("stickslip.contract"):
+            assert not [d for d in deps if d.startswith("stickslip.contract")], (name, deps)
+
 # --- module size and the tools' imports -------------------------------------------------------
 MAX_LINES = 600  # a module longer than this holds more than one idea: split it along them
 CODE_FOLDERS = ("stickslip", "pyref", "yade_law", "tools", "deme_model")
