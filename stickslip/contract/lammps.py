@@ -12,9 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..adapters.lammps import LAUNCHER
+from ..adapters.lammps import LAUNCHER, law_keywords
 from ..adapters.lammps_family import fmt as _f, run_script, serial_mpi_env
-from ..adapters.lammps_granular import LAUNCHER as GRANULAR_LAUNCHER
+from ..adapters.lammps_granular import LAUNCHER as GRANULAR_LAUNCHER, model_words
 from ..adapters.text_dumps import read_dump
 from . import cases as lc
 
@@ -46,9 +46,8 @@ def lammps_coefficients(case):
 
 
 def lammps_keywords(case, record=True):
-    """The law's keywords for a case (docs/law.md's rules), the record on or off."""
-    return (f"mu_k {_f(case.mu_k)} reset {case.reset} slip_timing {case.timing} history_rotation keep_length "
-            f"damping absolute lever_arm contact record {'yes' if record else 'no'}")
+    """The law's keywords for a case (docs/law.md's rules: the adapter's), the record on or off."""
+    return law_keywords(case.mu_k, case.reset, case.timing, record)
 
 
 def _piecewise(spans):
@@ -110,12 +109,7 @@ def granular_model(case, record=True):
         axis = 2 if case.geometry == "wall" else 0
         assert all(seg.velocity[axis] == 0 and not seg.omega for seg in case.segments), case.name
         nu_n = 1.0
-    x = case.nu_s / nu_n if case.nu_s > 0 else 0.0
-    assert x * nu_n == case.nu_s
-    name = ("stick_slip" + ("/total" if case.reset == "total" else "") + ("/exact" if case.timing == "exact" else "")
-            + ("/record" if record else ""))
-    return (f"hooke {_f(lc.KN)} {_f(nu_n)} damping velocity tangential {name} {_f(lc.KS)} {_f(x)} "
-            f"{_f(case.mu_s)} {_f(case.mu_k)} limit_damping")
+    return model_words(lc.KN, nu_n, lc.KS, case.nu_s, case.mu_s, case.mu_k, case.reset, case.timing, record)
 
 
 class GranularSubModel:

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..adapters.lammps_family import fmt as _f, run_script, serial_mpi_env
-from ..adapters.liggghts import LAUNCHER
+from ..adapters.liggghts import LAUNCHER, law_settings
 from ..adapters.text_dumps import read_dump
 from . import cases as lc
 
@@ -20,11 +20,7 @@ def liggghts_script(case):
     """A LIGGGHTS input for the case: grains created at their places with the model's
     record on, no integrator (grains stay where `set` puts them), each segment a `run`
     (a turn: `fix move rotate`, which also sets the spins), every step dumped at %.17g."""
-    settings = "absolute_damping on limitForce on stick_slip_record on"
-    if case.reset == "total":
-        settings += " slip_reset_total on"
-    if case.timing == "exact":
-        settings += " exact_slip_timing on"
+    settings = law_settings(case.reset, case.timing)
     lines = ["atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
              "communicate single vel yes", "units si", "region box block -4 4 -4 4 -4 4 units box",
              "create_box 1 box", "neighbor 0.25 bin", "neigh_modify delay 0"]
@@ -108,8 +104,7 @@ def run_liggghts_type_pairs(timing="step"):
     mu_s = " ".join(_f(coeff[tuple(sorted((i, j)))][0]) for i in (1, 2, 3) for j in (1, 2, 3))
     mu_k = " ".join(_f(coeff[tuple(sorted((i, j)))][1]) for i in (1, 2, 3) for j in (1, 2, 3))
     same = lambda v: " ".join([_f(v)] * 9)  # noqa: E731
-    settings = "absolute_damping on limitForce on stick_slip_record on" + (
-        " exact_slip_timing on" if timing == "exact" else "")
+    settings = law_settings("spring", timing)
     d = 2 * lc.R - lc.DELTA
     z = lc.R - lc.DELTA
     # (id, type, position, velocity): two grains on the floor, then three pairs up high

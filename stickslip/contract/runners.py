@@ -13,7 +13,7 @@ LAMMPS' two routes (lammps.py); DEM-Engine's force model through its CPU shim (d
 """
 from __future__ import annotations
 
-from .. import scene as scene_mod
+from .. import law_options, scene as scene_mod
 from ..adapters.lammps_family import fmt as _f
 from . import cases as lc
 from .lammps import run_lammps, run_lammps_granular, run_lammps_granular_type_pairs, run_lammps_type_pairs
@@ -44,6 +44,7 @@ name = "floor"
 point = [0.0, 0.0, 0.0]
 normal = [0.0, 0.0, 1.0]
 """ if case.geometry == "wall" else ""
+    options = "\n".join(law_options.words("pyref", explicit=True, reset=case.reset, slip_timing=case.timing))
     text = f"""
 name = "contract"
 dimension = 3
@@ -58,8 +59,7 @@ ks = {lc.KS!r}
 nu_s = {case.nu_s!r}
 mu_s = {case.mu_s!r}
 mu_k = {case.mu_k!r}
-reset = "{case.reset}"
-slip_timing = "{case.timing}"
+{options}
 [time]
 dt = {lc.DT!r}
 duration = {case.steps * lc.DT!r}
