@@ -17,8 +17,11 @@ from typing import NamedTuple
 import numpy as np
 
 LAWS = ("stick_slip", "visco_elastic", "visco_plastic", "coulomb")
-RESETS = ("spring", "total")
-SLIP_TIMINGS = ("step", "exact")
+# The law's options (docs/law.md), as the scene file, pyref, the YADE law and DEM-Engine's
+# model name them: each option's values, the law's default first. Each engine's spelling of
+# them, and of the options only an engine has, is stickslip/law_options.py's table.
+OPTIONS = {"reset": ("spring", "total"), "slip_timing": ("step", "exact")}
+RESETS, SLIP_TIMINGS = OPTIONS["reset"], OPTIONS["slip_timing"]
 
 # Exact slip timing (docs/law.md, "Exact slip timing"): slips are followed one by one
 # until the force direction has settled along -V_s (its part across -V_s below
@@ -50,8 +53,8 @@ class LawParams:
     nu_s: float  # 0 when tangential damping is switched off
     mu_s: float
     mu_k: float
-    reset: str = "spring"  # spring (eq. 8 read literally) | total
-    slip_timing: str = "step"  # step (the paper: slip tested at the end of the step) | exact
+    reset: str = RESETS[0]  # spring (eq. 8 read literally) | total
+    slip_timing: str = SLIP_TIMINGS[0]  # step (the paper: slip tested at the end of the step) | exact
 
     def __post_init__(self):
         self.check()
@@ -71,14 +74,13 @@ def check_parameters(law="stick_slip", **given) -> dict:
     mu_s, mu_k, reset, slip_timing; mu_k needs mu_s): ValueError naming the parameter and
     its allowed range. The one checker of the Python engines (scenes prefix "contact.",
     the YADE law calls it with its arguments). Returns them, numbers as floats."""
-    unknown = set(given) - {"kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k", "reset", "slip_timing"}
+    unknown = set(given) - {"kn", "nu_n", "ks", "nu_s", "mu_s", "mu_k"} - set(OPTIONS)
     if unknown:
         raise TypeError(f"check_parameters: unknown parameter {sorted(unknown)[0]!r}")
     if law not in LAWS:
         raise ValueError(f"law = {law!r}: must be one of {', '.join(LAWS)}")
     out = {}
-    for name in ("reset", "slip_timing"):
-        allowed = RESETS if name == "reset" else SLIP_TIMINGS
+    for name, allowed in OPTIONS.items():
         if name in given and given[name] not in allowed:
             raise ValueError(f"{name} = {given[name]!r}: must be one of {', '.join(allowed)}")
         if name in given:

@@ -91,14 +91,15 @@ def test_case_kinds_are_only_named_in_their_modules():
 def test_adapters_know_only_their_engine_and_the_time_series_columns():
     """stickslip/adapters/ holds the adapters and their dump readers: no case kind, study,
     benchmark, report or runner is known there (the runner calls them, not the reverse).
-    stickslip.shipped (where the engines' files are, in a checkout or a wheel) knows nothing."""
+    stickslip.shipped (where the engines' files are, in a checkout or a wheel) knows nothing;
+    stickslip.law_options (the law's options and each engine's words for them) pyref's only."""
     g = graph()
     adapters = [n for n in g if n.startswith("stickslip.adapters")]
-    assert len(adapters) >= 6 and not g["stickslip.shipped"]
+    assert len(adapters) >= 6 and not g["stickslip.shipped"] and g["stickslip.law_options"] == {"pyref.laws"}
     for name in adapters:
         for dep in g[name]:
-            assert dep.startswith(("stickslip.adapters", "pyref")) or dep in ("stickslip.columns", "stickslip.shipped"), \
-                (name, dep)
+            assert dep.startswith(("stickslip.adapters", "pyref")) or dep in (
+                "stickslip.columns", "stickslip.shipped", "stickslip.law_options"), (name, dep)
 
 
 def test_benchmarks_and_studies_are_leaves():
@@ -112,6 +113,16 @@ def test_benchmarks_and_studies_are_leaves():
             if dep.startswith("stickslip.studies") and not name.startswith(("stickslip.studies", "stickslip.bench")):
                 assert name in ("stickslip.cli", "stickslip.report"), (name, dep)
 
+
+
+def test_the_contract_is_reached_from_tests_and_tools_only():
+    """stickslip/contract/ holds the law's contract and the drivers that hold each engine to it
+    (they use the adapters): nothing a run needs, so no module outside it imports it."""
+    g = graph()
+    assert "stickslip.contract.runners" in g and "stickslip.adapters.lammps" in g["stickslip.contract.lammps"]
+    for name, deps in g.items():
+        if not name.startswith("stickslip.contract"):
+            assert not [d for d in deps if d.startswith("stickslip.contract")], (name, deps)
 
 # --- module size and the tools' imports -------------------------------------------------------
 MAX_LINES = 600  # a module longer than this holds more than one idea: split it along them

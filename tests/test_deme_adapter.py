@@ -180,7 +180,7 @@ def _compile_angle(code):
     it (a function of the float t), returning the angle 2 atan2(|q_xyz|, q_w)."""
     import tempfile
     from pathlib import Path
-    import deme_shim
+    from stickslip.contract import deme_shim
 
     src = ('#include "deme_shim.h"\n#include <cstdio>\n#include <cstdlib>\n'
            "static float4 q(float t) { " + code + " }\n"

@@ -10,9 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-import contract_runners as runners
-import deme_shim
-import law_contract as lc
+from stickslip.contract import cases as lc, deme_shim
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tools"))
 import deme_fn_ring as fn_ring  # noqa: E402
@@ -24,7 +22,7 @@ import deme_gpu_contract as contract  # noqa: E402
 def test_contract_rows_prescribed_as_they_are_stated():
     """Each row's position, velocity and spin expressions, compiled as the engine's integration
     kernel runs them (functions of the float t), give at t = (k - 2) dt the state
-    contract_runners._state gives step k (the engine's force step k sees the prescription of
+    cases.state gives step k (the engine's force step k sees the prescription of
     the step before; step 1 the initial state): to 1e-12 m, m/s, rad/s (doubles; the engine's
     grid of 64 m / 2^37 = 4.7e-10 m rounds them again)."""
     cases = [deme_shim.float_case(c) for c in lc.CASES]
@@ -36,11 +34,11 @@ def test_contract_rows_prescribed_as_they_are_stated():
             exprs = [e for group in contract.row_prescription(case, body, base) for e in group]
             funcs.append(f"static void f{len(funcs)}(float t, double *o) {{ " +
                          " ".join(f"o[{i}] = {e};" for i, e in enumerate(exprs)) + " }")
-            states, start, k = [], runners.rest_positions(case, case.segments[0].delta), 0
+            states, start, k = [], lc.rest_positions(case, case.segments[0].delta), 0
             for seg in case.segments:
                 begin = start
                 for s in range(1, seg.steps + 1):
-                    x, v, w = runners._state(case, seg, s, begin)
+                    x, v, w = lc.state(case, seg, s, begin)
                     states.append(np.r_[x[body] + base, v[body], w[body]])
                 start = x
             wanted.append(np.array(states))

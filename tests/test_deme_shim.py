@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """DEM-Engine's force model (deme_model/stick_slip.cu) pinned without a GPU: the same file,
-compiled on the CPU through deme_model/shim/ (tests/deme_shim.py), through every row of the
+compiled on the CPU through deme_model/shim/ (stickslip/contract/deme_shim.py), through every row of the
 law's contract in float, and the parts the contract's rows do not reach (the engine's
 Hertz-Mindlin normal force, a tensile Fn, a turning wall's velocity, the sweep's per-owner
 coefficients).
@@ -8,17 +8,16 @@ coefficients).
 Tolerances, for float: a row exact in double is exact in float too (its values are small
 multiples of powers of 2, with fewer than 24 significant bits); a row's ulps count its
 roundings, the same count in any binary format, so they are float ulps here
-(law_contract.compare with dtype float32); the bounds that add up roundings (the 100
+(cases.compare with dtype float32); the bounds that add up roundings (the 100
 slips of max_explicit_slips, the turning pair's |D|) use float's epsilon 2^-23. The one
-row about a single ulp takes mu_s one float ulp above 15/32 (tests/deme_shim.float_case).
+row about a single ulp takes mu_s one float ulp above 15/32 (deme_shim.float_case).
 """
 import math
 
 import numpy as np
 import pytest
 
-import deme_shim as shim
-import law_contract as lc
+from stickslip.contract import cases as lc, deme_shim as shim
 
 F32 = np.float32
 
@@ -35,7 +34,7 @@ def test_contract_in_float(case, sweep):
 def _slide_on_wall(c, steps, mats=(1, 1)):
     """A grain on the floor (overlap 1/32: Fn = 1) sliding one X a step along x, no dashpot;
     the trace of each step (force on A, spring, slips)."""
-    trace = shim.runners._empty(steps)
+    trace = lc.empty_trace(steps)
     x = np.array([[0.0, 0.0, lc.R - lc.DELTA]])
     v = np.array([[lc.X / lc.DT, 0.0, 0.0]])
     for k in range(steps):
@@ -52,7 +51,7 @@ def _slide_on_wall(c, steps, mats=(1, 1)):
 def test_coefficients_per_type_pair(timing):
     """mu_s and mu_k read for the contact's own pair of material types (the engine's
     mu[bodyAMatType][bodyBMatType], mu_k likewise): every pair different
-    (law_contract.TYPE_PAIRS), within 1 float ulp."""
+    (cases.TYPE_PAIRS), within 1 float ulp."""
     coeff = lc.type_pair_coefficients()
     for pair in lc.TYPE_PAIRS:
         c = shim.Contact(f"ss_hooke_{timing}_spring")
@@ -269,7 +268,7 @@ def test_the_library_has_every_variant():
 
 
 def _slow_shrink(label, nu_s):
-    """law_contract's max_explicit_slips rows with mu_k = 63/128 (Fmin = 31/64, r = 31/32 for
+    """cases.py's max_explicit_slips rows with mu_k = 63/128 (Fmin = 31/64, r = 31/32 for
     15/16): the part q across u stays larger through the 100 slips followed one by one
     (0.0104 after them, not 4e-4), so E7's closed form after them differs from one taken
     after 50 by 1.3e-3 along u, above float's bound 800 eps (T + rate) = 4.3e-4 (which the
@@ -287,7 +286,7 @@ E7_CASES = [c for c in lc.CASES if c.name.startswith("max_explicit_slips")] + [
 
 @pytest.mark.parametrize("case", E7_CASES, ids=lambda c: c.name)
 def test_closed_form_after_the_followed_slips_in_float(case):
-    """E7 in float, along u and across it. Along u (the slips' times summed: law_contract's
+    """E7 in float, along u and across it. Along u (the slips' times summed: cases.py's
     bound, 800 eps (T + rate)); across u, a bound of its own: the part q shrinks by r at
     each slip exactly in arithmetic, and each slip adds to it the roundings of adding along
     u and of taking q out (4 eps T), which shrink by r after: at most 4 eps T / (1 - r), plus
@@ -302,7 +301,7 @@ def test_closed_form_after_the_followed_slips_in_float(case):
     q_end = r ** n * q
     bound = 4 * F32_EPS * T / (1 - r) + 3 * (100 + n) * F32_EPS * q_end
     got = shim.run_case(case)["F"][-1]
-    want_across = -q_end if L > 0 else 0.0  # (the force on i: its part across u along -x, law_contract)
+    want_across = -q_end if L > 0 else 0.0  # (the force on i: its part across u along -x, cases.py)
     assert abs(got[0] - want_across) <= bound, (got[0], want_across, bound)
 
 

@@ -7,8 +7,8 @@ takes, from the source Debian's LAMMPS builds (lammps_plugin/lammps_api.h).
 - `plugin load` registers it and `plugin list` shows it;
 - renamed, with stock's arguments and no law keyword, it is stock `gran/hooke/history` of the
   same LAMMPS bit for bit: a small pour's dumps and thermo, 1 and 2 ranks, newton off and on;
-- the law's keywords keep the law's contract (tests/law_contract.py): the pair rows of the
-  legacy styles' batch (tests/contract_runners.py) with a `plugin load` line first, and every
+- the law's keywords keep the law's contract (stickslip/contract/cases.py): the pair rows of the
+  legacy styles' batch (stickslip/contract/lammps.py) with a `plugin load` line first, and every
   type pair with its own mu_s, mu_k in both slip timings (that script loads the plugin from
   LAMMPS_PLUGIN_PATH, LAMMPS' other way to load one);
 - a bad keyword stops the run with one ERROR line.
@@ -27,11 +27,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import contract_runners as runners
-import law_contract as lc
 from conftest import needs_engine, skip_engine
 from lammps_runs import CRASH_MARKERS, error_lines, read_dump, run_lammps
 from stickslip.adapters import lammps_granular
+from stickslip.contract import cases as lc, lammps as runners
 
 pytestmark = needs_engine("lammps_granular")  # LAMMPS 2025 built (the plugin is built with it)
 
@@ -208,7 +207,7 @@ def test_the_pair_rows_of_the_contract():
 @pytest.mark.parametrize("timing", ["step", "exact"])
 def test_every_type_pair_keeps_the_contract(tmp_path, monkeypatch, timing):
     """Six grain pairs of types 1..3 sliding, each with its own mu_s and mu_k from pair_coeff,
-    through the legacy styles' script (tests/contract_runners.py's lammps_type_pairs) on
+    through the legacy styles' script (stickslip/contract/lammps.py's lammps_type_pairs) on
     LAMMPS 2025: the plugin is loaded at start-up from LAMMPS_PLUGIN_PATH, where LAMMPS loads
     every file named *plugin.so."""
     (tmp_path / "stickslip_lammps2025plugin.so").symlink_to(PLUGIN)

@@ -115,16 +115,16 @@ def test_unlike_types_mix_by_geometric_means(tmp_path):
     """Types 1 and 2 given their own coefficients only (pair_coeff 1 1, 2 2): a 1-2 contact
     takes the geometric means, mu_s = sqrt(0.25 * 1.0) = 0.5 and mu_k = sqrt(0.2 * 0.8).
     A grain pair of types 1 and 2 slides at 1/64 of a unit a step with Fn = 1 and Ks = 1
-    (law_contract's units): the spring reaches mu_s = 0.5 at step 32 exactly, the first
+    (stickslip/contract/cases.py's units): the spring reaches mu_s = 0.5 at step 32 exactly, the first
     slip, and the force drops to 2 mu_k - mu_s (1 ulp: the slip's rescale). Read from
     compute pair/local's record (p13-p17)."""
     import math
 
     import numpy as np
 
-    import law_contract as lc
     import lammps_runs
-    from contract_runners import LAMMPS_HEAD, _f, granular_model, lammps_pair_local, lammps_pair_row
+    from stickslip.contract import cases as lc
+    from stickslip.contract.lammps import LAMMPS_HEAD, _f, granular_model, lammps_pair_local, lammps_pair_row
 
     d = 2 * lc.R - lc.DELTA
     own = {1: (0.25, 0.2), 2: (1.0, 0.8)}

@@ -214,15 +214,15 @@ def test_every_type_pair_has_its_own_coefficients(tmp_path):
 def test_pair_local_without_record_caps_at_each_pairs_own_threshold():
     """Without `record`, compute pair/local's p1-p3 re-evaluate the force from the stored
     spring (single(): trial force, brought to Fmin at or above mu_s Fn), with the contact's
-    own type pair's coefficients. The contract's six type pairs (tests/law_contract.py,
+    own type pair's coefficients. The contract's six type pairs (stickslip/contract/cases.py,
     Fn = 1, one X a step, step timing, reset spring) with a dashpot nu_s V = 7 X: before
     the first slip the spring holds k X after step k, and the re-evaluation is the applied
     force k + 7; the first slip comes where k + 7 reaches T (k = T - 7); from then on every
     step slips (Fmin + 1 + 7 >= T, since T - Fmin = 6 for every pair), the spring is Fmin and
     its re-evaluation Fmin + 7 >= T is brought back to Fmin. A pair read with another pair's
     coefficients (a larger T) reports Fmin + 7 instead. ~0.4 s."""
-    import law_contract as lc
-    from contract_runners import lammps_type_pairs
+    from stickslip.contract import cases as lc
+    from stickslip.contract.lammps import lammps_type_pairs
 
     dashpot = 7  # nu_s V in X: nu_s = 7/16, V = 1/4 = X/dt
     rows = lammps_type_pairs("step", nu_s=dashpot * lc.X / 0.25, record=False)

@@ -1,15 +1,14 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The law's contract on every engine (tests/law_contract.py): one-contact cases with
+"""The law's contract on every engine (stickslip/contract/cases.py): one-contact cases with
 exact numbers, each engine's record compared to hand-worked values to the ulp."""
 import math
 
 import numpy as np
 import pytest
 
-import contract_runners as runners
-import law_contract as lc
 from conftest import skip_engine
 from stickslip.adapters import ENGINES, OPTIONAL_ENGINES
+from stickslip.contract import cases as lc, runners
 
 
 @pytest.mark.parametrize("engine", sorted(runners.RUNNERS))
@@ -23,7 +22,7 @@ def test_every_engine_has_the_contract():
     """An engine added to stickslip.adapters.ENGINES must bring its contract runner (or
     say whose kernel it runs); an optional one (OPTIONAL_ENGINES) a runner or a CPU shim."""
     missing = set(ENGINES) - set(runners.RUNNERS) - set(runners.SHARED_KERNEL)
-    assert not missing, f"engines without a contract runner in tests/contract_runners.py: {sorted(missing)}"
+    assert not missing, f"engines without a contract runner in stickslip/contract/runners.py: {sorted(missing)}"
     unpinned = set(OPTIONAL_ENGINES) - set(runners.RUNNERS) - set(runners.CPU_SHIMS)
     assert not unpinned, f"optional engines whose law no test runs without their hardware: {sorted(unpinned)}"
     undecided = set(runners.RUNNERS) - set(runners.TYPE_PAIR_RUNNERS) - set(runners.NO_TYPE_PAIRS)
@@ -73,7 +72,7 @@ def _share_expected(name):
     if name == "dashpot_keeps_it_sliding_exact_timing":
         return np.r_[np.ones(8), np.zeros(4)], 0.0
     if name == "plastic_flow_reset_total_inside_step_exact_timing":
-        theta = (math.sqrt(320.0) - 17.0) / 1.25  # the slip inside step 21 (law_contract._flow_after_hit)
+        theta = (math.sqrt(320.0) - 17.0) / 1.25  # the slip inside step 21 (cases._flow_after_hit)
         return np.r_[np.ones(20), theta], 64 * lc.EPS  # (the root's cancellation: ~20 eps relative)
     if name == "max_explicit_slips_slides_exact_timing":
         theta = lc.max_slips_follow(CASE[name])[0]  # sticks between its 100 slips, then slides

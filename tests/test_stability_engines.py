@@ -83,7 +83,7 @@ def test_contact_opening_while_sliding(engine, tmp_path):
     """A grain bouncing while dragged: the contact opens and closes; Fs = 0 whenever
     Fn = 0 (checked in run_checked), the contact did open and land again (twice: starting
     5 um deep it flies ~8 ms a bounce, test_stability's scene) and slipped. (That a landing
-    starts from a zero spring is the law contract's: tests/law_contract.py, recontact.)"""
+    starts from a zero spring is the law contract's: stickslip/contract/cases.py, recontact.)"""
     sc = make(vel=[0.01, 0.0], imposed=["x"], height=0.005 - 5e-6, nu_n=0.0, duration=0.02, dt=5e-6)
     df = run_checked(engine, sc, tmp_path)
     touching = df["g-floor_fn"].to_numpy()[1:] > 0

@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Install without a clone: `python -m build` makes an sdist and a wheel; the wheel, installed
 into a new virtual environment in a folder outside the repository, runs `stickslip run drag`
-(pyref) and `stickslip calibrate` on the files it carries with the checkout's answers, gives
-the DEM-Engine model's text, and YADE imports the law from it and runs a scene. pip takes the
+(pyref) and `stickslip calibrate` on the files it carries with the checkout's answers, holds
+pyref to the law's contract (stickslip.contract), gives the DEM-Engine model's text, and YADE
+imports the law from it and runs a scene. pip takes the
 dependencies from the registry (after ./run.sh setup, from its cache). Opt-in (--runslow):
 about a minute of building and installing; `./run.sh wheel-check` runs it, and CI does.
 """
@@ -68,6 +69,9 @@ def test_the_wheel_installed_outside_the_repository_runs_pyref_calibrate_and_the
     assert all(Path(p).is_relative_to(venv) for p in where[:3]) and Path(where[2]).is_file(), where
     assert where[3] == VERSION and "#define STICKSLIP_HOOKE" in where[4]
     assert run([venv / "bin" / "stickslip", "--version"], cwd=work, env=env) == f"stickslip {VERSION}\n"
+    # the law's contract travels with the package: every row on the wheel's pyref
+    run([venv / "bin" / "python", "-c", "from stickslip.contract import cases, runners\n"
+         "for c in cases.CASES: cases.compare(c, runners.run_pyref(c))"], cwd=work, env=env)
 
     # pyref on the wheel's scene file, and calibrate on its measured map: the checkout's answers
     run([venv / "bin" / "stickslip", "run", "drag", "--quiet"], cwd=work, env=env)

@@ -2,11 +2,11 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """DEM-Engine on a GPU, in one run (tools/gpu_check.sh sets up `deme` and calls this):
 
-  contract   every row of tests/law_contract.py on the engine, side by side in one solver
+  contract   every row of stickslip/contract/cases.py on the engine, side by side in one solver
              (the force model's sweep: each row's coefficients, timing and reset per owner;
              positions, velocities and spins prescribed per family as the rows state them),
-             against the hand-worked values (law_contract.compare, float) and the CPU
-             shim's values (tests/deme_shim.py) for the same row (tools/deme_gpu_contract.py)
+             against the hand-worked values (cases.compare, float) and the CPU
+             shim's values (stickslip/contract/deme_shim.py) for the same row (tools/deme_gpu_contract.py)
   drag, tilt the paper's cases through the adapter (stickslip/adapters/deme.py) against pyref,
              with bounds derived for float and the engine's start (see BOUNDS)
   bench      a bed of >= 500 000 spheres settling in a box: the stick-slip model (Hertz-Mindlin
@@ -43,7 +43,7 @@ import traceback
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+sys.path.insert(0, str(ROOT))
 
 from deme_fn_ring import fn_spread, ring_of  # noqa: E402
 from deme_gpu_bench import bench_lines, run_bench, run_warm_stock  # noqa: E402

@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The GPU check's contract part (tools/deme_gpu_check.py): every row of tests/law_contract.py
+"""The GPU check's contract part (tools/deme_gpu_check.py): every row of stickslip/contract/cases.py
 on DEM-Engine side by side in one solver (the force model's sweep: each row's coefficients,
 timing and reset per owner; positions, velocities and spins prescribed per family as the
-rows state them), judged against the hand-worked values (law_contract.compare, float) and
-the CPU shim's values (tests/deme_shim.py) for the same row."""
+rows state them), judged against the hand-worked values (cases.compare, float) and
+the CPU shim's values (stickslip/contract/deme_shim.py) for the same row."""
 from __future__ import annotations
 
 import math
@@ -30,15 +30,14 @@ def row_prescription(case, body, base):
     set) for body 0 (grain i) or 1 (grain j) of a contract row placed at `base`: (position,
     velocity, spin), each 3 strings. The engine's force step k (1-based) sees the initial state
     for k = 1, else the prescription evaluated at t = (k - 2) dt; it must give
-    contract_runners._state of step k. A segment [a, b] then holds while t < (b - 3/2) dt; in
+    cases.state of step k. A segment [a, b] then holds while t < (b - 3/2) dt; in
     a turn the step in the segment is k - a + 1 = t/dt + 3 - a."""
-    import contract_runners as runners
-    import law_contract as lc
+    from stickslip.contract import cases as lc
 
     dt = lc.DT
     spans = segment_spans(case)
     pos, vel, spin = [[], [], []], [[], [], []], [[], [], []]
-    start = runners.rest_positions(case, case.segments[0].delta)
+    start = lc.rest_positions(case, case.segments[0].delta)
     for a, b, seg in spans:
         if seg.omega:
             s = start[body]
@@ -50,11 +49,11 @@ def row_prescription(case, body, base):
                  f"({_r(seg.omega)} * (cos({ang}) * {_r(s[0])} - sin({ang}) * {_r(s[1])}))", "0.0"]
             w = ["0.0", "0.0", _r(seg.omega)]
         else:
-            xs, vs, _ = runners._state(case, seg, 1, start)
+            xs, vs, _ = lc.state(case, seg, 1, start)
             x = [_r(base[i] + xs[body][i]) for i in range(3)]
             v = [_r(vs[body][i]) for i in range(3)]
             w = ["0.0", "0.0", "0.0"]
-            start = runners.rest_positions(case, seg.delta)
+            start = lc.rest_positions(case, seg.delta)
         for lst, e in ((pos, x), (vel, v), (spin, w)):
             for i in range(3):
                 lst[i].append((b, e[i]))
@@ -81,10 +80,8 @@ def row_layout(cases):
 
 def run_contract(args, log):
     import numpy as np
-    import contract_runners as runners
-    import law_contract as lc
-    import deme_shim
     from stickslip.adapters import deme as adapter
+    from stickslip.contract import cases as lc, deme_shim
 
     deme = adapter._import_deme()
     ss = adapter.helper()
@@ -99,7 +96,7 @@ def run_contract(args, log):
     sphere = solver.LoadSphereType(1000.0 * 4 / 3 * math.pi * lc.R ** 3, lc.R, mat)
     trackers, families = [], []
     for k, (case, base) in enumerate(zip(cases, bases)):
-        x0 = runners.rest_positions(case, case.segments[0].delta)
+        x0 = lc.rest_positions(case, case.segments[0].delta)
         v0 = np.zeros_like(x0)
         v0[0] = case.segments[0].velocity
         bodies = []
@@ -138,7 +135,7 @@ def run_contract(args, log):
                                        slip_timing=case.timing, reset=case.reset)
     owner = [int(tr.GetOwnerID()) for tr in trackers]
     steps = max(c.steps for c in cases)
-    traces = [runners._empty(c.steps) for c in cases]
+    traces = [lc.empty_trace(c.steps) for c in cases]
     names = ss.RECORD_WILDCARDS
     t1 = time.perf_counter()
     for k in range(steps):
@@ -165,13 +162,13 @@ def run_contract(args, log):
 def normals(case):
     """The law's normal (i to j) at each step of a row, from its prescribed states."""
     import numpy as np
-    import contract_runners as runners
+    from stickslip.contract import cases as lc
 
-    out, start, k = np.zeros((case.steps, 3)), runners.rest_positions(case, case.segments[0].delta), 0
+    out, start, k = np.zeros((case.steps, 3)), lc.rest_positions(case, case.segments[0].delta), 0
     for seg in case.segments:
         begin = start
         for s in range(1, seg.steps + 1):
-            x, _, _ = runners._state(case, seg, s, begin)
+            x, _, _ = lc.state(case, seg, s, begin)
             if case.geometry == "wall":
                 out[k] = (0.0, 0.0, -1.0)
             else:
@@ -187,8 +184,7 @@ def judge_row(case, trace):
     difference in float ulps of the row's largest force or spring), and, if it fails, whether
     the engine's trace matches one step earlier or later (a misplaced prescription)."""
     import numpy as np
-    import deme_shim
-    import law_contract as lc
+    from stickslip.contract import cases as lc, deme_shim
 
     trace["n"] = normals(case)
     out = {"row": case.name}

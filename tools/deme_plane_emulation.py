@@ -14,7 +14,7 @@ Each step does what DEM-Engine 3.0.19's sphere-plane force kernel does before th
   - the plane's point is its owner plus the turned relative position (wall_placement);
   - the distance is dot(A - B, n) in double, returned as float (planeSignedDistance), and
     the overlap is the float radius less it; the contact point and lever arms follow;
-then calls the force model through the CPU shim (tests/deme_shim.py, the same .cu file) and
+then calls the force model through the CPU shim (stickslip/contract/deme_shim.py, the same .cu file) and
 moves the grain by the engine's centred difference, v(t + dt/2) = v(t - dt/2) + dt a,
 x += dt v(t + dt/2), spin held at zero. Positions are kept in double (the engine's grid,
 box/2^38, is finer than anything here).
@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path[:0] = [str(ROOT), str(ROOT / "tests"), str(ROOT / "tools")]
+sys.path[:0] = [str(ROOT), str(ROOT / "tools")]
 
 F32 = np.float32
 
@@ -60,7 +60,7 @@ def conjugate(q):
 
 def emulate(scene, model_distance):
     """One run (see the module's text): a pyref-like Recording of the scene's output."""
-    import deme_shim as shim
+    from stickslip.contract import deme_shim as shim
     from stickslip.adapters import deme as adapter
 
     g, w = scene.grains[0], scene.walls[0]

@@ -36,14 +36,14 @@ done
 if [ -n "$CACHE" ] && [ -f "$CACHE" ]; then
     xz -T0 -dc "$CACHE" | tar -x -C "$W" && echo "gpu_check: JIT cache from $CACHE"
 fi
-export PYTHONPATH="$W/site:$PWD:$PWD/tests${PYTHONPATH:+:$PYTHONPATH}"
+export PYTHONPATH="$W/site:$PWD${PYTHONPATH:+:$PYTHONPATH}"
 echo "gpu_check: unpacked in $(( $(date +%s) - t0 )) s"
 { nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader; python3 --version;
   python3 -c "import deme; print('deme', deme.__version__)"; } 2>&1 | tee "$OUT/gpu.txt"
 python3 -c "import deme" 2>/dev/null || { echo "gpu_check: import deme fails"; exit 2; }
 # the force model's CPU shim (drag and tilt bounds, tools/deme_plane_emulation.py): carried in
 # build/deme_shim/ from a machine that ran the tests, else built here with g++
-python3 -c "import deme_shim; print('gpu_check: CPU shim', deme_shim.library_path())" 2>&1 | tail -1
+python3 -c "from stickslip.contract import deme_shim; print('gpu_check: CPU shim', deme_shim.library_path())" 2>&1 | tail -1
 python3 tools/deme_gpu_check.py --out "$OUT" --cache "$W/jit" "$@"
 status=$?
 # the compiled kernels, for a rerun (files back from the machine: at most 16 MiB each)

@@ -23,8 +23,10 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
-from lammps_runs import read_dump, run_lammps  # noqa: E402
+sys.path.insert(0, str(ROOT))
+from stickslip.adapters.lammps import LAUNCHER  # noqa: E402
+from stickslip.adapters.lammps_family import run_script  # noqa: E402
+from stickslip.adapters.text_dumps import read_dump  # noqa: E402
 
 LAW = "mu_k 0.4 reset spring slip_timing exact history_rotation keep_length record yes"
 N2 = 200
@@ -94,6 +96,15 @@ def kinetic(log):
             except ValueError:
                 pass
     return out
+
+
+def run_lammps(folder, name, script, np_):
+    """`script` as in.<name> in `folder`, run there on np_ ranks as the adapters run theirs
+    (its log: log.<name>); an ERROR line raises ValueError."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / f"in.{name}").write_text(script)
+    cmd = [str(LAUNCHER), "-in", f"in.{name}", "-log", f"log.{name}", "-echo", "none", "-nocite"]
+    run_script("LAMMPS", cmd, folder, 0, None, np_ranks=np_, env={"OMP_NUM_THREADS": "1"})
 
 
 def main():

@@ -36,7 +36,7 @@ import time
 
 import numpy as np
 
-from .. import columns, shipped
+from .. import columns, law_options, shipped
 from . import RunResult
 
 NAME = "deme"
@@ -233,7 +233,8 @@ def build(scene, deme):
     c, eff = scene.contact, scene.effects
     p = c.law_params(eff)
     solver = new_solver(deme)
-    ss.attach(solver, normal="hooke", slip_timing=c.slip_timing, reset=c.reset, record=True)
+    ss.attach(solver, normal="hooke",
+              **law_options.arguments("deme", reset=c.reset, slip_timing=c.slip_timing, record="yes"))
     mat = solver.LoadMaterial({"kn": p.kn, "nu_n": p.nu_n, "ks": p.ks, "nu_s": p.nu_s, "mu": p.mu_s, "mu_k": p.mu_k})
     box = domain(scene)
     solver.InstructBoxDomainDimension(*box)

@@ -30,6 +30,7 @@ from . import RunResult
 from . import missing
 from .lammps_family import box, boundary, fmt as _fmt, integrated, run_script, vec as _vec, work_folder
 from . import lid_script, ramp_script
+from .. import law_options
 from .text_dumps import (atoms_dump, id_ranges, optional_dump, pair_record, recorded, run_lines, slips_dump,
                          stats_dump, timeseries)
 
@@ -42,8 +43,13 @@ LAUNCHER = BUILD / "lmp-stickslip"
 # A wall's per-atom record (lammps_plugin/README.md, `record yes`): column 1 the contact
 # flag, 9 Fn, 10-12 the tangential force on the grain, 13 the contact's slip count
 WALL_FLAG, WALL_FN, WALL_NSLIP = 1, 9, 13
-# the law of docs/law.md, in the plugin's keywords
-LAW_KEYWORDS = "history_rotation keep_length lever_arm contact damping absolute record yes"
+
+
+def law_keywords(mu_k, reset, slip_timing, record=True):
+    """The plugin's keywords for docs/law.md's law (every rule written out: the styles default
+    to stock's), mu_k, the reset and slip timing given, the record on or off."""
+    law = law_options.the_law(reset=reset, slip_timing=slip_timing, record="yes" if record else "no")
+    return f"mu_k {_fmt(mu_k)} " + " ".join(law_options.words("lammps", explicit=True, **law))
 
 
 def available():
@@ -100,8 +106,7 @@ class _Script:
         # limit_damping: no attractive normal force (docs/law.md step 2, Fn = max(0, ...))
         dampflag = 1 if nu_s > 0 else 0
         args = f"{_fmt(c.kn)} {_fmt(c.ks)} {_fmt(nu_n)} {_fmt(nu_s)} {_fmt(c.mu_s)} {dampflag} limit_damping"
-        keywords = f"mu_k {_fmt(c.mu_k)} reset {c.reset} slip_timing {c.slip_timing} {LAW_KEYWORDS}"
-        return args, keywords
+        return args, law_keywords(c.mu_k, c.reset, c.slip_timing)
 
     # The contact model's lines, the one part a LAMMPS with another granular syntax changes
     # (stickslip/adapters/lammps_granular.py): the pair style, a wall's fix, pair/local's record.

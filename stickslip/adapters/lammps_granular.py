@@ -23,6 +23,7 @@ import math
 import os
 from pathlib import Path
 
+from .. import law_options
 from .lammps import REPO, _Script, _fmt, run_with
 
 NAME = "lammps_granular"
@@ -77,10 +78,15 @@ def dashpot_ratio(nu_s, nu_n):
     return x
 
 
-def sub_model_name(contact):
-    """`stick_slip` with the scene's options as the name's suffixes, and the record."""
-    return ("stick_slip" + ("/total" if contact.reset == "total" else "")
-            + ("/exact" if contact.slip_timing == "exact" else "") + "/record")
+def model_words(kn, nu_n, ks, nu_s, mu_s, mu_k, reset, slip_timing, record=True):
+    """The granular model's words for a Hookean contact with the law: `damping velocity`
+    (nu_n absolute), the sub-model `stick_slip` with the options as the name's suffixes, its
+    dashpot x = nu_s/nu_n (nu_s > 0 needs nu_n > 0)."""
+    x = dashpot_ratio(nu_s, nu_n) if nu_s > 0.0 else 0.0
+    name = law_options.sub_model(reset=reset, slip_timing=slip_timing, record="yes" if record else "no")
+    damping = " ".join(law_options.words("lammps_granular", damping="absolute"))
+    return (f"hooke {_fmt(kn)} {_fmt(nu_n)} {damping} tangential {name} "
+            f"{_fmt(ks)} {_fmt(x)} {_fmt(mu_s)} {_fmt(mu_k)} limit_damping")
 
 
 def granular_model(scene):
@@ -91,9 +97,7 @@ def granular_model(scene):
     if nu_s > 0.0 and nu_n == 0.0:
         raise ValueError("contact.nu_s: LAMMPS' granular model scales the tangential dashpot by the normal one, "
                          "so nu_s > 0 needs nu_n > 0 (effects.normal_damping on)")
-    x = dashpot_ratio(nu_s, nu_n) if nu_s > 0.0 else 0.0
-    return (f"hooke {_fmt(c.kn)} {_fmt(nu_n)} damping velocity tangential {sub_model_name(c)} "
-            f"{_fmt(c.ks)} {_fmt(x)} {_fmt(c.mu_s)} {_fmt(c.mu_k)} limit_damping")
+    return model_words(c.kn, nu_n, c.ks, nu_s, c.mu_s, c.mu_k, c.reset, c.slip_timing)
 
 
 class _GranularScript(_Script):

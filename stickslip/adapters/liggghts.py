@@ -23,6 +23,7 @@ from . import missing
 from .lammps_family import (box, boundary, fmt as _fmt, integrated, run_script, serial_mpi_env, vec as _vec,
                             work_folder)
 from . import lid_script, ramp_script
+from .. import law_options
 from .text_dumps import atoms_dump, optional_dump, pair_record, recorded, run_lines, slips_dump, stats_dump, timeseries
 
 NAME = "liggghts"
@@ -36,6 +37,14 @@ PRELOAD = BUILD / "libstickslip_liggghts.so"
 # D (3 values), then Fn, F_s (3), cumulative slip count
 RECORD_FN, RECORD_FS, RECORD_NSLIP = 4, 5, 8
 HISTORY_VALUES = 8
+
+
+def law_settings(reset, slip_timing):
+    """The contact-model settings of docs/law.md's law with its record on: `hooke/stiffness`'s
+    absolute damping (gamman_abs, gammat_abs are nu_n, nu_s), no tensile normal force
+    (limitForce, step 2), the reset and slip timing given."""
+    return " ".join(["limitForce on"] + law_options.words("liggghts", reset=reset, slip_timing=slip_timing,
+                                                          damping="absolute", record="yes"))
 
 
 def available():
@@ -69,12 +78,7 @@ class _Script:
             model += f" rolling_friction {c.rolling}"
         for k, (name, value) in enumerate(props.items()):
             self.add(f"fix m{k} all property/global {name} peratomtypepair 1 {_fmt(value)}")
-        settings = "absolute_damping on limitForce on stick_slip_record on"
-        if c.reset == "total":
-            settings += " slip_reset_total on"
-        if c.slip_timing == "exact":
-            settings += " exact_slip_timing on"
-        return model, settings
+        return model, law_settings(c.reset, c.slip_timing)
 
     def _mesh_file(self, w, half):
         """A wall as two triangles; the shared diagonal crosses the wall's point at half/2

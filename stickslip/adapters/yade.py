@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import columns, shipped
+from .. import columns, law_options, shipped
 from . import RunResult
 from . import missing
 
@@ -45,7 +45,7 @@ def scene_dict(scene):
     return {
         "dimension": scene.dimension, "effects": scene.effects, "gravity": v(scene.gravity),
         "contact": {"kn": c.kn, "nu_n": c.nu_n, "ks": c.ks, "nu_s": c.nu_s, "mu_s": c.mu_s, "mu_k": c.mu_k,
-                    "reset": c.reset, "slip_timing": c.slip_timing},
+                    **law_options.arguments("yade", reset=c.reset, slip_timing=c.slip_timing)},
         "dt": scene.dt, "steps": scene.steps, "every": scene.output.every,
         "grains": [{"name": g.name, "radius": g.radius, "mass": scene.grain_mass(g),
                     "inertia": scene.grain_inertia(g), "position": v(g.position), "velocity": v(g.velocity),

@@ -89,21 +89,20 @@ LABEL = {"stock": "stock gran/hooke/history", "step": "gran/hooke/stickslip, ste
 PAIR_FUNCTIONS = ("PairGranHookeHistory::compute", "PairGranHookeStickSlip::", "exact_slips", "exact_general")
 WALL_FUNCTIONS = ("FixWallGran::", "FixWallGranStickSlip::")  # stock's post_force and hooke_history; ours
 
-# in.pour's settings around its chute run; ${pair} and ${wall} choose the styles
-TIMED = """\
-atom_style sphere
+# in.pour's settings around its chute run, both LAMMPS benchmarks' timed scene (chute_script)
+CHUTE = """\
+{units}atom_style sphere
 boundary p p fm
 newton off
 comm_modify vel yes
 read_data {data}
 neighbor 0.2 bin
 neigh_modify delay 0
-pair_style ${{pair}}
-pair_coeff * *
+{pair}
 timestep 0.001
 fix 1 all nve/sphere
 fix 2 all gravity 1.0 chute 26.0
-fix zlower all ${{wall}}
+{wall}
 compute c all contact/atom
 compute cs all reduce sum c_c
 thermo_style custom step atoms c_cs
@@ -114,6 +113,15 @@ run {warm}
 thermo {steps}
 run {steps} pre no post no
 {after}"""
+
+
+def chute_script(data, pair, wall, warm, steps, before="", after="", units=""):
+    """The chute's input on the grains of `data`: `pair` the pair style's lines, `wall` the
+    floor's fix line, WARM untimed steps then `steps` timed ones with `before` and `after`
+    around them; `units` a first line (LAMMPS' default units: none)."""
+    return CHUTE.format(units=units, data=data, pair=pair, wall=wall, warm=warm, steps=steps, before=before,
+                        after=after)
+
 
 # Appends the on-CPU time (ns) of the LAMMPS process that runs it through `shell` (its
 # nearest ancestor named lmp-stickslip) to probe.log. Shell built-ins only.
@@ -191,7 +199,9 @@ def _command(config, nproc=1):
 
 
 def _script(data, steps, before="", after=""):
-    return TIMED.format(data=data, warm=WARM, steps=steps, before=before, after=after)
+    """The timed input; ${pair} and ${wall} (_command's -var) choose the styles."""
+    return chute_script(data, "pair_style ${pair}\npair_coeff * *", "fix zlower all ${wall}", WARM, steps, before,
+                        after)
 
 
 def _folder(work, name):

@@ -130,33 +130,6 @@ label settled
 write_data bed.data
 """
 
-# lammps.py's chute on the bed; the model written into the script, pair and wall alike
-TIMED = """\
-units lj
-atom_style sphere
-boundary p p fm
-newton off
-comm_modify vel yes
-read_data {data}
-neighbor 0.2 bin
-neigh_modify delay 0
-pair_style granular
-pair_coeff * * {model}
-timestep 0.001
-fix 1 all nve/sphere
-fix 2 all gravity 1.0 chute 26.0
-fix floor all wall/gran granular {model} zplane 0.0 NULL
-compute c all contact/atom
-compute cs all reduce sum c_c
-thermo_style custom step atoms c_cs
-thermo_modify norm no
-thermo {warm}
-run {warm}
-{before}
-thermo {steps}
-run {steps} pre no post no
-{after}"""
-
 # on-CPU time (ns) of the LAMMPS process (named lmp) that runs it through `shell`, appended to probe.log
 PROBE = probe_script("lmp)", 'read -r s < /proc/$p/schedstat\necho "${s%% *}" >> probe.log')
 
@@ -230,7 +203,11 @@ def _command(infile="in.timed", lmp=None):
 
 def script(data, config, steps=STEPS, warm=WARM, before="", after=""):
     """The input of one configuration's run on the bed `data`."""
-    return TIMED.format(data=data, model=model(config), warm=warm, steps=steps, before=before, after=after)
+    # lammps.py's chute on the bed; the model written into the script, pair and wall alike
+    m = model(config)
+    return base.chute_script(data, f"pair_style granular\npair_coeff * * {m}",
+                             f"fix floor all wall/gran granular {m} zplane 0.0 NULL", warm, steps, before, after,
+                             units="units lj\n")
 
 
 def _timed(data, config, work, steps, warm, lmp):

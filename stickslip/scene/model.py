@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pyref.laws import LawParams
+from pyref.laws import RESETS, SLIP_TIMINGS, LawParams
 
 from . import stability
 
@@ -31,8 +31,8 @@ class Contact:
     nu_s: float
     mu_s: float
     mu_k: float
-    reset: str = "spring"
-    slip_timing: str = "step"  # step (the paper, literally) | exact (docs/law.md)
+    reset: str = RESETS[0]  # spring (eq. 8, the paper) | total (docs/law.md)
+    slip_timing: str = SLIP_TIMINGS[0]  # step (the paper, literally) | exact (docs/law.md)
     # rolling resistance: "" (none) or "epsd2" (LIGGGHTS' elastic-plastic spring-dashpot
     # model: a torque opposing the relative rolling, capped at rolling_mu * R * Fn)
     rolling: str = ""

@@ -297,8 +297,8 @@ def _contact(ct) -> Contact:
         nu_s=ct.number("nu_s", 0.0),
         mu_s=ct.number("mu_s", required=True),
         mu_k=ct.number("mu_k", required=True),
-        reset=ct.string("reset", "spring", RESETS),
-        slip_timing=ct.string("slip_timing", "step", SLIP_TIMINGS),
+        reset=ct.string("reset", RESETS[0], RESETS),
+        slip_timing=ct.string("slip_timing", SLIP_TIMINGS[0], SLIP_TIMINGS),
         rolling=ct.string("rolling", "", ("",) + ROLLING_MODELS),
         rolling_mu=ct.number("rolling_mu", 0.0, lo=0, hi=1),
     )

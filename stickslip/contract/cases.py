@@ -17,8 +17,8 @@ Geometry (docs/law.md step 1; the normal n points from grain i to j):
 - "pair": grain i at (-d/2, 0, 0), grain j at (+d/2, 0, 0), d = 1 - delta, j at rest;
   n = +x, i moves at V (+ v_n along x).
 
-Engines: tests/contract_runners.py has one function per engine that runs a case and
-returns what the contact recorded each step. YADE runs pyref's kernel itself
+Engines: stickslip/contract/runners.py has one function per engine that runs a case and
+returns what the contact recorded each step (a trace: empty_trace). YADE runs pyref's kernel itself
 (yade_law/stickslip_yade/kernel.py imports pyref/laws.py), so it has no entry of its
 own: its checks are of its geometry and integration, the law's are pyref's.
 """
@@ -91,6 +91,31 @@ def tangential(case, velocity):
 
 def w_of(velocity):
     return np.array(velocity) * DT
+
+
+def rest_positions(case, delta):
+    """The places of the case's grains at overlap `delta` (the module's docstring, Geometry)."""
+    if case.geometry == "wall":
+        return np.array([[0.0, 0.0, R - delta]])
+    d = 2 * R - delta
+    return np.array([[-d / 2, 0.0, 0.0], [d / 2, 0.0, 0.0]])
+
+
+def state(case, seg, k_in_seg, start):
+    """Positions, velocities and spins of the case's grains at step k_in_seg (1-based) of a
+    segment; `start` holds the positions the segment starts from (a turn starts where the
+    grains are)."""
+    if seg.omega:
+        a = seg.omega * DT * k_in_seg
+        c, s = math.cos(a), math.sin(a)
+        rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        x = start @ rot.T
+        spin = np.array([0.0, 0.0, seg.omega])
+        v = np.cross(spin, x)
+        return x, v, np.tile(spin, (len(x), 1))
+    v = np.zeros((len(start), 3))
+    v[0] = seg.velocity
+    return rest_positions(case, seg.delta), v, np.zeros((len(start), 3))
 
 
 def sawtooth(first_loaded, start, slips_at, fmin, dashpot, reset, n, f_at_slip=None):
@@ -462,6 +487,16 @@ def vector(value, w):
     return np.array(value, float) if isinstance(value, tuple) else value * w
 
 
+def empty_trace(n):
+    """A trace of n steps with the contact apart at each: what an engine's driver fills in
+    (stickslip/contract/runners.py) and compare() reads. Per step, what the contact recorded
+    at its end: "fn" (N,), "F" (N, 3) the force on i, "D" (N, 3) the spring (None for the whole
+    trace where the engine's record has no spring: LAMMPS), "slips" (N,) the steps that slipped
+    since the contact began, "n" (N, 3) the normal from i to j; NaN (slips: -1) while apart."""
+    return {"fn": np.full(n, np.nan), "F": np.full((n, 3), np.nan), "D": np.full((n, 3), np.nan),
+            "slips": np.full(n, -1), "n": np.full((n, 3), np.nan)}
+
+
 def compare(case, trace, dtype=np.float64):
     """Each step's recorded Fn, force, spring and slip count against expected(case). dtype:
     the engine's floating type; a case's ulps are ulps of it (the count of roundings on the
@@ -484,7 +519,7 @@ def compare(case, trace, dtype=np.float64):
             where = f"{case.name}: step {k + 1}"
             assert got["fn"] == e.fn, (where, "Fn", got["fn"], e.fn)
             assert np.all(np.abs(got["F"] - F) <= tol), (where, "force", got["F"], F)
-            if got["D"] is not None:  # (None: the engine's record has no spring; see contract_runners)
+            if got["D"] is not None:  # (None: the engine's record has no spring; empty_trace)
                 assert np.all(np.abs(got["D"] - D) <= tol), (where, "spring", got["D"], D)
             assert got["slips"] == e.slips, (where, "slips since the contact began", got["slips"], e.slips)
         k0 += seg.steps

@@ -1,304 +1,23 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""One function per engine that runs a case of tests/law_contract.py and returns what its
-contact recorded at the end of each step: {"fn": (N,), "F": (N, 3) force on i,
-"D": (N, 3) spring, "slips": (N,) steps that slipped since the contact began,
-"n": (N, 3) normal from i to j}; NaN where the contact is apart.
-
-A new engine is one more function here and one entry in RUNNERS (the test fails for an
-engine of stickslip.adapters.ENGINES that has neither an entry nor a reason in
-SHARED_KERNEL). An engine whose record has no spring returns "D": None (LAMMPS).
-"""
+"""The law's contract on LAMMPS (runners.py), both routes: lammps_plugin/'s styles on
+Debian's LAMMPS (LegacyStyles) and the tangential sub-model in LAMMPS 2025's granular model
+(GranularSubModel), run by the adapters' launchers, read back from the law's record through
+the adapters' dump reader."""
 from __future__ import annotations
 
 import dataclasses
 import math
-import os
-import subprocess
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-import law_contract as lc
-from stickslip import scene as scene_mod
-from stickslip.adapters.lammps_family import serial_mpi_env
+from ..adapters.lammps import LAUNCHER, law_keywords
+from ..adapters.lammps_family import fmt as _f, run_script, serial_mpi_env
+from ..adapters.lammps_granular import LAUNCHER as GRANULAR_LAUNCHER, model_words
+from ..adapters.text_dumps import read_dump
+from . import cases as lc
 
-# YADE's law calls pyref's kernel (yade_law/stickslip_yade/kernel.py imports pyref/laws.py):
-# the law's arithmetic there is pyref's; its own tests check its geometry and integration.
-SHARED_KERNEL = {"yade": "runs pyref's kernel (yade_law/stickslip_yade/kernel.py imports pyref/laws.py)"}
-# Engines of stickslip.adapters.OPTIONAL_ENGINES, whose hardware CI lacks: where their law's
-# own file runs every row without it.
-CPU_SHIMS = {"deme": "tests/test_deme_shim.py: deme_model/stick_slip.cu compiled on the CPU (deme_model/shim/), "
-                     "every row in float"}
-
-
-def _state(case, seg, k_in_seg, start):
-    """Positions, velocities and spins of the case's grains at step k_in_seg (1-based) of a
-    segment; `start` holds the positions the segment starts from (a turn starts where the
-    grains are)."""
-    if seg.omega:
-        a = seg.omega * lc.DT * k_in_seg
-        c, s = math.cos(a), math.sin(a)
-        rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        x = start @ rot.T
-        spin = np.array([0.0, 0.0, seg.omega])
-        v = np.cross(spin, x)
-        return x, v, np.tile(spin, (len(x), 1))
-    v = np.zeros((len(start), 3))
-    v[0] = seg.velocity
-    return rest_positions(case, seg.delta), v, np.zeros((len(start), 3))
-
-
-def rest_positions(case, delta):
-    if case.geometry == "wall":
-        return np.array([[0.0, 0.0, lc.R - delta]])
-    d = 2 * lc.R - delta
-    return np.array([[-d / 2, 0.0, 0.0], [d / 2, 0.0, 0.0]])
-
-
-# ---------------------------------------------------------------- pyref
-
-def _pyref_scene(case):
-    grains = "".join(f"""
-[[grain]]
-name = "{name}"
-radius = {lc.R!r}
-density = 1000.0
-position = [{_f(x[0])}, {_f(x[1])}, {_f(x[2])}]
-""" for name, x in zip("ij", rest_positions(case, case.segments[0].delta)))
-    wall = """
-[[wall]]
-name = "floor"
-point = [0.0, 0.0, 0.0]
-normal = [0.0, 0.0, 1.0]
-""" if case.geometry == "wall" else ""
-    text = f"""
-name = "contract"
-dimension = 3
-[effects]
-rotation = {str(any(s.omega for s in case.segments)).lower()}
-normal_damping = {str(case.nu_n > 0).lower()}
-tangential_damping = {str(case.nu_s > 0).lower()}
-[contact]
-kn = {lc.KN!r}
-nu_n = {case.nu_n!r}
-ks = {lc.KS!r}
-nu_s = {case.nu_s!r}
-mu_s = {case.mu_s!r}
-mu_k = {case.mu_k!r}
-reset = "{case.reset}"
-slip_timing = "{case.timing}"
-[time]
-dt = {lc.DT!r}
-duration = {case.steps * lc.DT!r}
-""" + grains + wall
-    import tomllib
-    return scene_mod.parse(tomllib.loads(text))
-
-
-def run_pyref(case):
-    """pyref's contact pass (pyref/solver.py: geometry, the history carried from step to step
-    or dropped, then pyref/laws.py) at each prescribed state; nothing is integrated."""
-    from pyref import Simulation
-
-    sim = Simulation(_pyref_scene(case), record=False)
-    out = _empty(case.steps)
-    x = sim.x.copy()
-    k, slips = 0, 0
-    for seg in case.segments:
-        start = x
-        for s in range(1, seg.steps + 1):
-            x, v, w = _state(case, seg, s, start)
-            sim.x, sim.v, sim.w = x.copy(), v.copy(), w.copy()
-            sim.f, sim.torque = sim._forces()
-            c = sim.contacts
-            if len(c.key):
-                slips += int(c.slipped[0])
-                out["fn"][k], out["F"][k], out["D"][k], out["n"][k] = c.fn[0], c.force[0], sim.D[0], c.n[0]
-                out["slips"][k] = slips
-            else:
-                slips = 0
-            k += 1
-    return out
-
-
-def _empty(n):
-    return {"fn": np.full(n, np.nan), "F": np.full((n, 3), np.nan), "D": np.full((n, 3), np.nan),
-            "slips": np.full(n, -1), "n": np.full((n, 3), np.nan)}
-
-
-# ---------------------------------------------------------------- LIGGGHTS
-
-def _f(x):
-    return repr(float(x))
-
-
-def liggghts_script(case, types=None):
-    """A LIGGGHTS input for the case: grains created at their places with the model's
-    record on, no integrator (grains stay where `set` puts them), each segment a `run`
-    (a turn: `fix move rotate`, which also sets the spins), every step dumped at %.17g."""
-    settings = "absolute_damping on limitForce on stick_slip_record on"
-    if case.reset == "total":
-        settings += " slip_reset_total on"
-    if case.timing == "exact":
-        settings += " exact_slip_timing on"
-    lines = ["atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
-             "communicate single vel yes", "units si", "region box block -4 4 -4 4 -4 4 units box",
-             "create_box 1 box", "neighbor 0.25 bin", "neigh_modify delay 0"]
-    for k, (name, value) in enumerate((("kn", lc.KN), ("kt", lc.KS), ("gamman_abs", case.nu_n),
-                                       ("gammat_abs", case.nu_s), ("coefficientFriction", case.mu_s),
-                                       ("coefficientKineticFriction", case.mu_k))):
-        lines.append(f"fix m{k} all property/global {name} peratomtypepair 1 {_f(value)}")
-    lines += [f"pair_style gran model hooke/stiffness tangential stick_slip {settings}", "pair_coeff * *",
-              f"timestep {_f(lc.DT)}"]
-    x0 = rest_positions(case, case.segments[0].delta)
-    for x in x0:
-        lines.append(f"create_atoms 1 single {_f(x[0])} {_f(x[1])} {_f(x[2])} units box")
-    lines.append(f"set atom * diameter {_f(2 * lc.R)} density 1000")
-    fmt = lambda n: " ".join(["%.17g"] * n)  # noqa: E731
-    cols = "id x y z vx vy vz omegax omegay omegaz"
-    if case.geometry == "wall":
-        lines.append(f"fix floor all wall/gran model hooke/stiffness tangential stick_slip primitive type 1 "
-                     f"zplane 0.0 {settings}")
-        cols += " " + " ".join(f"f_history_floor[{k}]" for k in range(1, 9))
-    else:
-        lines += ["compute pl all pair/gran/local id history",
-                  "dump c all local 1 dump.pair " + " ".join(f"c_pl[{k}]" for k in (1, 2, 4, 5, 6, 7, 8, 9, 10, 11)),
-                  f'dump_modify c format "{fmt(10)}"']
-    ncol = len(cols.split())
-    lines += [f"dump d all custom 1 dump.atoms {cols}", f'dump_modify d sort id format "%d {fmt(ncol - 1)}"']
-    for seg in case.segments:
-        if seg.omega:
-            period = 2 * math.pi / seg.omega
-            lines += [f"fix turn all move rotate 0 0 0 0 0 1 {_f(period)}", f"run {seg.steps}", "unfix turn"]
-            continue
-        for a, x in enumerate(rest_positions(case, seg.delta)):
-            v = seg.velocity if a == 0 else (0.0, 0.0, 0.0)
-            lines.append(f"set atom {a + 1} x {_f(x[0])} y {_f(x[1])} z {_f(x[2])} "
-                         f"vx {_f(v[0])} vy {_f(v[1])} vz {_f(v[2])}")
-        lines.append(f"run {seg.steps}")
-    return "\n".join(lines) + "\n"
-
-
-def read_dump(path):
-    """A LIGGGHTS dump -> {step: 2D array}; a step written twice (the end of one run and
-    the set-up of the next) keeps its last frame."""
-    frames, lines, i = {}, Path(path).read_text().split("\n"), 0
-    while i < len(lines):
-        if lines[i].startswith("ITEM: TIMESTEP"):
-            step, n = int(lines[i + 1]), int(lines[i + 3])
-            rows = [list(map(float, s.split())) for s in lines[i + 9:i + 9 + n]]
-            frames[step] = np.array(rows, float).reshape(n, -1) if n else np.zeros((0, 0))
-            i += 9 + n
-        else:
-            i += 1
-    return frames
-
-
-def run_liggghts_script(script, work: Path):
-    from stickslip.adapters.liggghts import LAUNCHER
-
-    (work / "in.contract").write_text(script)
-    # a serial run needs no MPI daemon: OpenMPI's isolated singleton starts none (measured:
-    # 0.35 s less a run, about half of a case's cost; stickslip/adapters/lammps_family.py)
-    env = dict(os.environ, **serial_mpi_env(work))
-    proc = subprocess.run([str(LAUNCHER), "-in", "in.contract", "-echo", "none", "-log", "log.contract"],
-                          cwd=work, capture_output=True, text=True, errors="replace", timeout=120, env=env)
-    errors = [line for line in proc.stdout.split("\n") if line.startswith("ERROR")]
-    assert proc.returncode == 0 and not errors, (proc.returncode, errors, proc.stdout[-2000:], proc.stderr[-2000:])
-
-
-def run_liggghts(case):
-    """The LIGGGHTS plugin's model (liggghts_plugin/tangential_model_stick_slip.h), read from
-    its own record: f_history_floor[1..8] (wall) or compute pair/gran/local's history
-    (pair): D (3), Fn, F_s (3), slips since the contact began."""
-    with tempfile.TemporaryDirectory(prefix="contract-") as tmp:
-        work = Path(tmp)
-        run_liggghts_script(liggghts_script(case), work)
-        atoms = read_dump(work / "dump.atoms")
-        pairs = read_dump(work / "dump.pair") if case.geometry == "pair" else None
-    out = _empty(case.steps)
-    for k in range(case.steps):
-        a = atoms[k + 1]
-        if case.geometry == "wall":
-            h = a[0][10:18]
-            normal = np.array([0.0, 0.0, -1.0])
-        else:
-            rows = pairs.get(k + 1, np.zeros((0, 10)))
-            if not len(rows):
-                continue
-            row = rows[0]
-            h = row[2:10].copy()
-            if row[0] > row[1]:  # stored as seen from grain 2: D and F_s change sign
-                h[0:3], h[4:7] = -h[0:3], -h[4:7]
-            d = a[1][1:4] - a[0][1:4]
-            normal = d / np.linalg.norm(d)
-        out["D"][k], out["fn"][k], out["F"][k], out["slips"][k], out["n"][k] = h[0:3], h[3], h[4:7], int(h[7]), normal
-    return out
-
-
-def run_liggghts_type_pairs(timing="step"):
-    """Five contacts side by side, one per pair of types with different coefficients
-    (law_contract.TYPE_PAIRS): grains of types 2 and 3 on the wall (type 1), sliding along x,
-    and pairs 2-3, 2-2, 3-3 (normal x) sliding along y. Returns {type pair: trace}."""
-    coeff = lc.type_pair_coefficients()
-    mu_s = " ".join(_f(coeff[tuple(sorted((i, j)))][0]) for i in (1, 2, 3) for j in (1, 2, 3))
-    mu_k = " ".join(_f(coeff[tuple(sorted((i, j)))][1]) for i in (1, 2, 3) for j in (1, 2, 3))
-    same = lambda v: " ".join([_f(v)] * 9)  # noqa: E731
-    settings = "absolute_damping on limitForce on stick_slip_record on" + (
-        " exact_slip_timing on" if timing == "exact" else "")
-    d = 2 * lc.R - lc.DELTA
-    z = lc.R - lc.DELTA
-    # (id, type, position, velocity): two grains on the floor, then three pairs up high
-    grains = [(1, 2, (-3.0, 0.0, z), (0.25, 0, 0)), (2, 3, (-1.0, 0.0, z), (0.25, 0, 0))]
-    contacts = {(1, 2): ("wall", 1), (1, 3): ("wall", 2)}
-    for k, ((ti, tj), cx) in enumerate((((2, 3), -2.0), ((2, 2), 0.5), ((3, 3), 3.0))):
-        a = 3 + 2 * k
-        grains += [(a, ti, (cx - d / 2, 0.0, 2.0), (0, 0.25, 0)), (a + 1, tj, (cx + d / 2, 0.0, 2.0), (0, 0, 0))]
-        contacts[(ti, tj)] = ("pair", a)
-    lines = ["atom_style sphere", "atom_modify map array", "boundary f f f", "newton off",
-             "communicate single vel yes", "units si", "region box block -4 4 -4 4 -4 4 units box",
-             "create_box 3 box", "neighbor 0.25 bin", "neigh_modify delay 0",
-             f"fix m0 all property/global kn peratomtypepair 3 {same(lc.KN)}",
-             f"fix m1 all property/global kt peratomtypepair 3 {same(lc.KS)}",
-             f"fix m2 all property/global gamman_abs peratomtypepair 3 {same(0)}",
-             f"fix m3 all property/global gammat_abs peratomtypepair 3 {same(0)}",
-             f"fix m4 all property/global coefficientFriction peratomtypepair 3 {mu_s}",
-             f"fix m5 all property/global coefficientKineticFriction peratomtypepair 3 {mu_k}",
-             f"pair_style gran model hooke/stiffness tangential stick_slip {settings}", "pair_coeff * *",
-             f"timestep {_f(lc.DT)}"]
-    for gid, t, x, v in grains:
-        lines += [f"create_atoms {t} single {_f(x[0])} {_f(x[1])} {_f(x[2])} units box",
-                  f"set atom {gid} diameter {_f(2 * lc.R)} density 1000 vx {_f(v[0])} vy {_f(v[1])} vz {_f(v[2])}"]
-    lines += [f"fix floor all wall/gran model hooke/stiffness tangential stick_slip primitive type 1 zplane 0.0 "
-              f"{settings}",
-              "compute pl all pair/gran/local id history",
-              "dump c all local 1 dump.pair " + " ".join(f"c_pl[{k}]" for k in (1, 2, 4, 5, 6, 7, 8, 9, 10, 11)),
-              'dump_modify c format "' + " ".join(["%.17g"] * 10) + '"',
-              "dump d all custom 1 dump.atoms id " + " ".join(f"f_history_floor[{k}]" for k in range(1, 9)),
-              'dump_modify d sort id format "%d ' + " ".join(["%.17g"] * 8) + '"',
-              f"run {lc.TYPE_PAIR_STEPS}"]
-    with tempfile.TemporaryDirectory(prefix="contract-") as tmp:
-        work = Path(tmp)
-        run_liggghts_script("\n".join(lines) + "\n", work)
-        atoms, pairs = read_dump(work / "dump.atoms"), read_dump(work / "dump.pair")
-    out = {}
-    for pair, (kind, gid) in contacts.items():
-        tr = _empty(lc.TYPE_PAIR_STEPS)
-        for k in range(lc.TYPE_PAIR_STEPS):
-            if kind == "wall":
-                h = atoms[k + 1][gid - 1][1:9]
-            else:
-                row = next(r for r in pairs[k + 1] if {int(r[0]), int(r[1])} == {gid, gid + 1})
-                h = row[2:10].copy()
-                if row[0] > row[1]:
-                    h[0:3], h[4:7] = -h[0:3], -h[4:7]
-            tr["D"][k], tr["fn"][k], tr["F"][k], tr["slips"][k] = h[0:3], h[3], h[4:7], int(h[7])
-        out[pair] = tr
-    return out
-
-
-# ---------------------------------------------------------------- LAMMPS
 # The plugin's styles with the law as docs/law.md states it (lammps_plugin/README.md):
 # keep_length, contact lever arm, absolute damping, limit_damping (Fn >= 0), record yes.
 # Its record holds Fn, the applied F_s and the slip count, not the spring D (history 0-2
@@ -327,9 +46,8 @@ def lammps_coefficients(case):
 
 
 def lammps_keywords(case, record=True):
-    """The law's keywords for a case (docs/law.md's rules), the record on or off."""
-    return (f"mu_k {_f(case.mu_k)} reset {case.reset} slip_timing {case.timing} history_rotation keep_length "
-            f"damping absolute lever_arm contact record {'yes' if record else 'no'}")
+    """The law's keywords for a case (docs/law.md's rules: the adapter's), the record on or off."""
+    return law_keywords(case.mu_k, case.reset, case.timing, record)
 
 
 def _piecewise(spans):
@@ -391,12 +109,7 @@ def granular_model(case, record=True):
         axis = 2 if case.geometry == "wall" else 0
         assert all(seg.velocity[axis] == 0 and not seg.omega for seg in case.segments), case.name
         nu_n = 1.0
-    x = case.nu_s / nu_n if case.nu_s > 0 else 0.0
-    assert x * nu_n == case.nu_s
-    name = ("stick_slip" + ("/total" if case.reset == "total" else "") + ("/exact" if case.timing == "exact" else "")
-            + ("/record" if record else ""))
-    return (f"hooke {_f(lc.KN)} {_f(nu_n)} damping velocity tangential {name} {_f(lc.KS)} {_f(x)} "
-            f"{_f(case.mu_s)} {_f(case.mu_k)} limit_damping")
+    return model_words(lc.KN, nu_n, lc.KS, case.nu_s, case.mu_s, case.mu_k, case.reset, case.timing, record)
 
 
 class GranularSubModel:
@@ -449,7 +162,7 @@ def _lammps_batch_script(cases, styles=LegacyStyles):
     for k, case in enumerate(cases):
         a = _first_atom(case, k)
         base = np.array([4.0 * (k % 7) - 12.0, 4.0 * (k // 7) - 12.0, 0.0])
-        x0 = rest_positions(case, case.segments[0].delta) + base
+        x0 = lc.rest_positions(case, case.segments[0].delta) + base
         if pair:  # (j stays where it is: i alone moves, along the normal too)
             lines.append(styles.pair_coeff(k + 1, case))
         for b, x in enumerate(x0):
@@ -469,7 +182,7 @@ def _lammps_batch_script(cases, styles=LegacyStyles):
                 assert seg is case.segments[-1], "a turn must be a case's last segment"
                 turns.setdefault(first - 1, []).append((k, seg, base))
                 break
-            xi = rest_positions(case, seg.delta)[0] + base
+            xi = lc.rest_positions(case, seg.delta)[0] + base
             if pair:
                 xi = x0[1] - [2 * lc.R - seg.delta, 0, 0]
             for q, value in zip(("dx", "dy", "dz", "vx", "vy", "vz"), (*(xi - x0[0]), *seg.velocity)):
@@ -491,21 +204,27 @@ def _lammps_batch_script(cases, styles=LegacyStyles):
     return "\n".join(lines) + "\n"
 
 
+def _run(work, name, script, exe):
+    """Runs a LAMMPS input (in.<name>) in `work` on `exe` as the adapters run theirs (one
+    process, no MPI daemon); an ERROR line raises ValueError."""
+    (work / f"in.{name}").write_text(script)
+    cmd = [str(exe), "-in", f"in.{name}", "-log", f"log.{name}", "-echo", "none", "-nocite"]
+    run_script("LAMMPS", cmd, work, 0, None, env={"OMP_NUM_THREADS": "1"}, serial_env=serial_mpi_env(work))
+
+
 def _lammps_batch(cases, styles=LegacyStyles, exe=None):
     """Runs the batch in `styles`' syntax on `exe` (None: the legacy styles' launcher);
     {case name: trace}."""
-    import lammps_runs
-
     with tempfile.TemporaryDirectory(prefix="contract-lammps-") as tmp:
         work = Path(tmp)
-        lammps_runs.run_lammps(work, "contract", _lammps_batch_script(cases, styles), exe=exe)
+        _run(work, "contract", _lammps_batch_script(cases, styles), exe or LAUNCHER)
         if cases[0].geometry == "wall":
-            records = [lammps_runs.read_dump(work / f"dump.case{k}") for k in range(len(cases))]
+            records = [read_dump(work / f"dump.case{k}") for k in range(len(cases))]
         else:
-            pairs, atoms = lammps_runs.read_dump(work / "dump.pairs"), lammps_runs.read_dump(work / "dump.atoms")
+            pairs, atoms = read_dump(work / "dump.pairs"), read_dump(work / "dump.atoms")
     out = {}
     for k, case in enumerate(cases):
-        tr = _empty(case.steps)
+        tr = lc.empty_trace(case.steps)
         tr["D"] = None  # not in LAMMPS' record (above)
         a = _first_atom(case, k)
         for s in range(case.steps):
@@ -586,18 +305,16 @@ def run_lammps(case):
 def run_lammps_granular(case):
     """The sub-model stick_slip (lammps_plugin/granular/) in LAMMPS 2025, read from its
     record (/record): the wall's per-atom columns 9-13 or compute pair/local's p13-p17."""
-    from stickslip.adapters import lammps_granular
-
     key = ("granular",) + _lammps_key(case)
     if key not in _LAMMPS_TRACES:
         batch = [c for c in lc.CASES if _lammps_key(c) == key[1:]]
-        _LAMMPS_TRACES[key] = _lammps_batch(batch, GranularSubModel, lammps_granular.LAUNCHER)
+        _LAMMPS_TRACES[key] = _lammps_batch(batch, GranularSubModel, GRANULAR_LAUNCHER)
     return _LAMMPS_TRACES[key][case.name]
 
 
 def lammps_type_pairs(timing="step", nu_s=0.0, record=True, styles=None, exe=None):
     """Six grain pairs side by side, one per pair of types 1..3, each with its own mu_s, mu_k
-    from pair_coeff (law_contract.TYPE_PAIRS; LAMMPS' wall has one mu_s and mu_k per fix, so
+    from pair_coeff (cases.TYPE_PAIRS; LAMMPS' wall has one mu_s and mu_k per fix, so
     type 1 is a grain type here and (1, 1) a pair too), grain i sliding at one X a step.
     Pairs with a grain of type 1 have their normal along y and slide along x, the others
     normal x, sliding along y (the directions test_coefficients_per_type_pair expects).
@@ -606,8 +323,6 @@ def lammps_type_pairs(timing="step", nu_s=0.0, record=True, styles=None, exe=Non
     F_s (p1-p3), slips (p12); without, p1-p3 (the force single() re-evaluates). styles:
     None, the legacy styles; GranularSubModel, LAMMPS 2025's granular model (on `exe`),
     whose record is p13, p14-p16, p17."""
-    import lammps_runs
-
     coeff = lc.type_pair_coefficients()
     d = 2 * lc.R - lc.DELTA
     law = lc.Case("", "", "pair", (), 0.5, 0.5, nu_s=nu_s, timing=timing)  # (every pair's mu from pair_coeff)
@@ -636,8 +351,8 @@ def lammps_type_pairs(timing="step", nu_s=0.0, record=True, styles=None, exe=Non
     lines += lammps_pair_local(columns) + [f"run {lc.TYPE_PAIR_STEPS}"]
     with tempfile.TemporaryDirectory(prefix="contract-lammps-") as tmp:
         work = Path(tmp)
-        lammps_runs.run_lammps(work, "types", "\n".join(lines) + "\n", exe=exe)
-        pairs = lammps_runs.read_dump(work / "dump.pairs")
+        _run(work, "types", "\n".join(lines) + "\n", exe or LAUNCHER)
+        pairs = read_dump(work / "dump.pairs")
     return {pair: np.array([lammps_pair_row(pairs[s + 1], a, forces) for s in range(lc.TYPE_PAIR_STEPS)])
             for pair, a in first.items()}
 
@@ -646,7 +361,7 @@ def run_lammps_type_pairs(timing="step", styles=None, exe=None):
     """lammps_type_pairs with the record: {type pair: trace}."""
     out = {}
     for pair, rows in lammps_type_pairs(timing, styles=styles, exe=exe).items():
-        tr = _empty(lc.TYPE_PAIR_STEPS)
+        tr = lc.empty_trace(lc.TYPE_PAIR_STEPS)
         tr["D"] = None  # not in LAMMPS' record
         tr["fn"], tr["F"], tr["slips"] = rows[:, 0], rows[:, 1:4], rows[:, 4].astype(int)
         out[pair] = tr
@@ -654,14 +369,4 @@ def run_lammps_type_pairs(timing="step", styles=None, exe=None):
 
 
 def run_lammps_granular_type_pairs(timing="step"):
-    from stickslip.adapters import lammps_granular
-
-    return run_lammps_type_pairs(timing, GranularSubModel, lammps_granular.LAUNCHER)
-
-
-RUNNERS = {"pyref": run_pyref, "liggghts": run_liggghts, "lammps": run_lammps, "lammps_granular": run_lammps_granular}
-# Cases an engine cannot express, and why (the README's table shows them).
-TYPE_PAIR_RUNNERS = {"liggghts": run_liggghts_type_pairs, "lammps": run_lammps_type_pairs,
-                     "lammps_granular": run_lammps_granular_type_pairs}
-NO_TYPE_PAIRS = {"pyref": "one material per scene: one mu_s, mu_k for every contact"}
-
+    return run_lammps_type_pairs(timing, GranularSubModel, GRANULAR_LAUNCHER)

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """DEM-Engine's force model (deme_model/stick_slip.cu) on the CPU: the shim library and a runner
-of the law's contract (tests/law_contract.py) through it.
+of the law's contract (cases.py) through it.
 
 deme_model/shim/contact_step.cpp includes the model's text in functions that declare the
 variables DEM-Engine's force kernel gives it; g++ builds them into one library (cached in
@@ -23,10 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
-import contract_runners as runners
-import law_contract as lc
+from . import cases as lc
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]  # the checkout: the shim builds from its deme_model/
 MODEL = ROOT / "deme_model"
 SOURCES = ("stick_slip.cu", "shim/deme_shim.h", "shim/deme_shim_layout.h", "shim/undef_options.h",
            "shim/contact_step.cpp")
@@ -218,16 +217,16 @@ def setup_contact(case, sweep):
 
 
 def run_case(case, sweep=False):
-    """The contract's trace of a case (contract_runners' format) through the shim: materials
+    """The contract's trace of a case (cases.empty_trace) through the shim: materials
     and the contact wildcards, or the sweep's owner wildcards and the record."""
     c = setup_contact(case, sweep)
-    out = runners._empty(case.steps)
-    x = runners.rest_positions(case, case.segments[0].delta)
+    out = lc.empty_trace(case.steps)
+    x = lc.rest_positions(case, case.segments[0].delta)
     k = 0
     for seg in case.segments:
         start = x
         for s in range(1, seg.steps + 1):
-            x, v, w = runners._state(case, seg, s, start)
+            x, v, w = lc.state(case, seg, s, start)
             delta, area, b2a, kin, a_pos, b_pos = contract_geometry(case, x, v, w)
             kin[L["K_TIME"]] = k * lc.DT
             force = c.step(delta, area, kin, a_pos, b_pos)
