@@ -167,6 +167,41 @@ def test_bad_calibrate_input_is_one_line_with_status_2(tmp_path, capsys, monkeyp
     assert code == 2 and message in err and err.count("\n") == 1, err
 
 
+def _broken(rows, column, value):
+    rows[column] = rows[column].astype(object)
+    rows.loc[2, column] = value
+    return rows
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda p: p.drop(columns="engine"), "no column 'engine': a map has the columns kind, engine, group"),
+    (lambda p: p.drop(columns=[c for c in p if c.endswith("_mean")]), "no column of a target's mean: expected one of "
+                                                                     "theta_start_mean"),
+    (lambda p: p.drop(columns="theta_stop_se"), "column theta_stop_mean has no theta_stop_se beside it"),
+    (lambda p: _broken(p, "mu_k", "half"), "column mu_k, line 4: 'half': expected a finite number"),
+    (lambda p: _broken(p, "mu_s", np.nan), "column mu_s, line 4: empty: expected a finite number"),
+    (lambda p: _broken(p, "theta_start_mean", "inf"), "column theta_start_mean, line 4: 'inf': expected a finite "
+                                                       "number"),
+    (lambda p: _broken(p, "theta_start_se", np.nan), "column theta_start_se, line 4: empty: expected a finite number "
+                                                      "(the standard error of the mean beside it)"),
+    (lambda p: p.assign(rolling=0.2), "column rolling has no map rows at --rolling 0: it was measured at 0.2 only"),
+    (lambda p: p.assign(engine="lammps"), "no rows with engine 'liggghts' and group 'sweep' or 'shear'"),
+    (None, "cannot be read as CSV"),
+])
+def test_a_malformed_map_is_one_line_naming_the_file_and_column(tmp_path, capsys, change, message):
+    """A map that is not study-3d's points.csv (a column missing or of the wrong type, an empty
+    cell where a number belongs, no rows at the rolling resistance asked) is refused in one
+    line naming the file, the column and what was expected, never a traceback."""
+    path = _synthetic_map(tmp_path)
+    if change is None:
+        path.write_bytes(b"\xff\xfe\x00binary")
+    else:
+        change(pd.read_csv(path, dtype={"nu_s": str})).to_csv(path, index=False)
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--map", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"stickslip: error: --map {path}: ") and message in err and err.count("\n") == 1, err
+
+
 def _curved_map(tmp_path, surface, mus=(0.2, 0.35, 0.5, 0.65, 0.8), se=0.05):
     """A points.csv of the dense map's layout (history on the diagonal, and on each row of
     mu_s a point on mu_k = mu_s / 2 and one half way) with theta_start = surface(mu_s, mu_k)."""

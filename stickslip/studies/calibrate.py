@@ -83,11 +83,11 @@ def targets_of(args):
     return out
 
 
-def prepare(pts, rolling, method="auto", lag=(math.nan, math.nan, None)):
+def prepare(pts, rolling, method="auto", lag=(math.nan, math.nan, None), source="the map"):
     """The surfaces of the map at this rolling resistance, by `method` ("auto": the one of
     smaller leave-one-out error), the interpolation's own error added, and the leave-one-out
     rows they came from."""
-    m = calibrate_map.from_points(pts, rolling)
+    m = calibrate_map.from_points(pts, rolling, source=source)
     rows = calibrate_map.loo(m)
     chosen = calibrate_map.choose(rows) if method == "auto" else method
     err = calibrate_map.interp_error(rows)
@@ -132,7 +132,7 @@ def main(args):
     path = args.map or DOCS / "points.csv"
     pts = calibrate_map.read_points(path)
     lag = calibrate_map.lag_of(path, pts)
-    surf, rows = prepare(pts, args.rolling, getattr(args, "interpolation", "auto") or "auto", lag)
+    surf, rows = prepare(pts, args.rolling, getattr(args, "interpolation", "auto") or "auto", lag, f"--map {path}")
     r = calibrate_fit.solve(targets, surf)
     print(_range_line(r, "mu_s", "mu_k"))
     print(_range_line(r, "mu_k", "mu_s"))

@@ -57,11 +57,47 @@ class Points:
         return np.where(np.isfinite(self.n) & (self.n > 1), self.n - 1.0, np.inf)
 
 
+# The columns a map must have (points.csv of `stickslip study-3d`): which rows are map points,
+# and where they lie. A target's columns are "<target>_mean", "_se" and, optionally, "_n".
+LABELS = ("kind", "engine", "group", "nu_s", "timing")
+NUMBERS = ("mu_s", "mu_k", "rolling")
+
+
 def read_points(path):
+    """The map's points from a CSV, or SceneError in one line naming the file, the column and
+    what was expected: the columns LABELS and NUMBERS, numbers where numbers belong, no empty
+    cell in NUMBERS, and for every target it has a mean of, that mean's standard error."""
     path = Path(path)
     if not path.is_file():
         raise SceneError(f"--map {path}: not found (stickslip study-3d writes it)")
-    return pd.read_csv(path, dtype={"nu_s": str})
+    try:
+        pts = pd.read_csv(path, dtype={c: str for c in LABELS})
+    except (OSError, ValueError, pd.errors.ParserError) as e:  # (UnicodeDecodeError is a ValueError)
+        raise SceneError(f"--map {path}: cannot be read as CSV ({' '.join(str(e).split())[:120]})") from None
+    missing = [c for c in (*LABELS, *NUMBERS) if c not in pts]
+    if missing:
+        raise SceneError(f"--map {path}: no column {missing[0]!r}: a map has the columns {', '.join(LABELS + NUMBERS)} "
+                         "(points.csv of stickslip study-3d)")
+    means = [t for t in TARGETS if f"{t}_mean" in pts]
+    if not means:
+        raise SceneError(f"--map {path}: no column of a target's mean: expected one of "
+                         f"{', '.join(t + '_mean' for t in TARGETS)}")
+    for t in means:
+        if f"{t}_se" not in pts:
+            raise SceneError(f"--map {path}: column {t}_mean has no {t}_se beside it: expected each mean's standard "
+                             "error")
+    for c in (*NUMBERS, *(f"{t}_{s}" for t in means for s in ("mean", "se", "n") if f"{t}_{s}" in pts)):
+        v = pd.to_numeric(pts[c], errors="coerce")
+        bad = pts[c].notna() & ~np.isfinite(v) | (pts[c].isna() & (c in NUMBERS))
+        if c.endswith("_se"):
+            bad |= pts[c].isna() & pts[c.replace("_se", "_mean")].notna()
+        if bad.any():
+            i = int(np.argmax(bad.to_numpy()))
+            cell = "empty" if pd.isna(pts[c].iloc[i]) else repr(str(pts[c].iloc[i]))
+            raise SceneError(f"--map {path}: column {c}, line {i + 2}: {cell}: expected a finite number"
+                             + (" (the standard error of the mean beside it)" if c.endswith("_se") else ""))
+        pts[c] = v
+    return pts
 
 
 def lag_of(path, pts):
@@ -73,23 +109,33 @@ def lag_of(path, pts):
     how = "ramp" if math.isfinite(lag) else None
     val = Path(path).with_name("validation.csv") if path is not None else None
     if val is not None and val.is_file():
-        v = pd.read_csv(val)
+        try:
+            v = pd.read_csv(val)
+        except (OSError, ValueError, pd.errors.ParserError) as e:
+            raise SceneError(f"{val} (beside --map): cannot be read as CSV ({' '.join(str(e).split())[:120]})") from None
         if "fixed_lag" in v:
+            need = [c for c in ("engine", "layers", "fixed_lag_se") if c not in v]
+            if need:
+                raise SceneError(f"{val} (beside --map): column fixed_lag without {need[0]!r}: expected "
+                                 "validation.csv of stickslip study-3d")
             v = v[(v.engine == "liggghts") & (v.layers == granular3d_tables.SCENE_LAYERS)]
             if len(v) and math.isfinite(v.fixed_lag.iloc[0]):
                 lag, lag_se, how = float(v.fixed_lag.iloc[0]), float(v.fixed_lag_se.iloc[0]), "fixed"
     return lag, lag_se, how
 
 
-def from_points(pts, rolling, nu_s="paper"):
+def from_points(pts, rolling, nu_s="paper", source="the map"):
     """{target: Points}: the map's points on LIGGGHTS at this rolling resistance, history
     (mu_s = mu_k) and the stick-slip pairs with the chosen nu_s in the step mode, as the
     ramp measured them (the lag to a fixed angle, common to every point, is added to the
-    predictions: calibrate_fit.surfaces)."""
+    predictions: calibrate_fit.surfaces). `source` names the map in a refusal."""
     pts = pts[(pts["engine"] == "liggghts") & pts["group"].isin(GROUPS)]
+    if not len(pts):
+        raise SceneError(f"{source}: no rows with engine 'liggghts' and group {' or '.join(map(repr, GROUPS))}: "
+                         "expected the map's points (points.csv of stickslip study-3d)")
     rolls = sorted(pts["rolling"].unique())
     if not any(math.isclose(rolling, r, abs_tol=1e-9) for r in rolls):
-        raise SceneError(f"--rolling {rolling:g}: the map was measured at rolling resistance "
+        raise SceneError(f"{source}: column rolling has no map rows at --rolling {rolling:g}: it was measured at "
                          f"{' and '.join(f'{r:g}' for r in rolls)} only")
     pts = pts[np.isclose(pts["rolling"], rolling)]
     pts = pts[(pts.mu_s == pts.mu_k) | ((pts.nu_s == nu_s) & (pts.timing == "step"))]
