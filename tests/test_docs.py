@@ -17,6 +17,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import skip_engine
@@ -450,7 +451,10 @@ def test_deme_example_sets_up_the_drag_as_the_adapter_does():
     assert len(example.log) > 20 and plain(example.log) == plain(run.log)
 
 
-def test_deme_example_reads_the_drag_from_the_record(capsys):
+def drag_as_the_examples_print_it(capsys):
+    """(the printed mean friction ratio, its text, the slips, the slip period in steps) of the
+    drag example, read by DEM-Engine's example from pyref's drag (the LIGGGHTS and LAMMPS
+    examples print the same figures: their tests above)."""
     from conftest import paper_case
     from deme_standin import FakeDeme
 
@@ -462,8 +466,61 @@ def test_deme_example_reads_the_drag_from_the_record(capsys):
     def record(family, name, step):  # the grain's record after `step` steps: pyref's row `step`
         return float(values[name].iat[step]) if name in values else 0.0
     deme_example().main(FakeDeme(record=record))
-    mean, count = mean_ratio(capsys.readouterr().out)
+    out = capsys.readouterr().out
+    mean, count = mean_ratio(out)
+    slip_steps = (df.t[df[f"{c}_slip"] > 0] / sc.dt).round().to_numpy()
+    period = float(np.mean(np.diff(slip_steps)))
+    return mean, re.search(r"mean friction ratio .*?: ([0-9.]+)", out).group(1), count, period
+
+
+def test_deme_example_reads_the_drag_from_the_record(capsys):
+    mean, _, count, _ = drag_as_the_examples_print_it(capsys)
     assert abs(mean - DRAG_MEAN) <= DRAG_TOL and count == DRAG_SLIPS, (mean, count)
+
+
+# A figure of the drag example stated on a page: the mean friction ratio over steps 1001-2500
+# (on a line naming the window or the mean friction ratio) and the slip period in steps.
+DRAG_PAGE_MEAN = re.compile(r"(?:1001-2500|mean friction ratio)\D*?(0\.45\d*)(\.\.\.)?")
+DRAG_PAGE_PERIOD = re.compile(r"period of ~(\d+) steps")
+
+
+def drag_findings(pages, shown_mean, period):
+    """Each page's drag figure that is not what the examples print: a mean friction ratio that
+    is not the printed one to the digits stated ("0.4502..." a prefix of it), a slip period
+    that is not the measured one to the step."""
+    found = []
+    for page in pages:
+        for n, line in enumerate(page.read_text().splitlines(), 1):
+            for m in DRAG_PAGE_MEAN.finditer(line):
+                stated, cut = m.group(1), m.group(2)
+                digits = len(stated.split(".")[1])
+                ok = (shown_mean.startswith(stated) if cut else
+                      digits <= len(shown_mean.split(".")[1]) and round(float(shown_mean), digits) == float(stated))
+                if not ok:
+                    found.append(f"{shown(page)}:{n}: mean {stated}{cut or ''}, the examples print {shown_mean}")
+            for m in DRAG_PAGE_PERIOD.finditer(line):
+                if int(m.group(1)) != round(period):
+                    found.append(f"{shown(page)}:{n}: period ~{m.group(1)} steps, measured {period:.1f}")
+    return found
+
+
+def test_drag_findings_catch_each_kind(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("over steps 1001-2500: 0.45025 (paper)\nthe mean friction ratio, 0.450\n"
+                    "over steps 1001-2500 (0.4505: the dashpot)\n1001-2500: 0.4502... (paper)\n"
+                    "1001-2500: 0.4503... (paper)\na period of ~166 steps\na period of ~165 steps\n")
+    got = [f.split(": ", 1)[1] for f in drag_findings([page], "0.45025", 166.2)]
+    assert got == ["mean 0.4505, the examples print 0.45025", "mean 0.4503..., the examples print 0.45025",
+                   "period ~165 steps, measured 166.2"], got
+
+
+def test_every_page_states_the_drag_as_the_examples_print_it(capsys):
+    """The drag example's mean friction ratio and slip period, wherever a page states them, are
+    the figures the examples print (the printed mean: pyref's drag read as the examples read
+    it, to the five decimals the LAMMPS and DEM-Engine examples print; LIGGGHTS prints more)."""
+    mean, text, _, period = drag_as_the_examples_print_it(capsys)
+    found = drag_findings(markdown_files(), text, period)
+    assert not found, "\n".join(found)
 
 
 def test_deme_example_runs_on_a_gpu(tmp_path):
@@ -496,3 +553,76 @@ def test_calibrate_examples_print_what_the_page_shows(page, command, shown):
     script = Path(sys.executable).parent / "stickslip"
     proc = subprocess.run([str(script), *command.split()[1:]], cwd=ROOT, capture_output=True, text=True)
     assert proc.stdout + proc.stderr == shown, page
+
+
+# --- figures stated on more than one page --------------------------------------------------------
+# A figure measured once and copied: each copy is checked against the table it comes from.
+
+def table_rows(text, header):
+    """The rows (lists of cells) of the markdown table whose header row starts with `header`."""
+    lines = text.splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.startswith(header))
+    rows = []
+    for ln in lines[start + 2:]:
+        if not ln.startswith("|"):
+            break
+        rows.append([c.strip() for c in ln.strip().strip("|").split("|")])
+    return rows
+
+
+def section(text, heading):
+    """The text of a page's section, from its heading to the next heading of its level."""
+    level = heading.split(" ")[0]
+    part = text.split(heading + "\n", 1)[1]
+    return re.split(rf"^{level} ", part, flags=re.M)[0]
+
+
+def cost_findings(readme, performance):
+    """Each figure of the README's cost table (its step and exact timing cells: "0.98×",
+    "0.98–1.03×", "7× slower") that is no rounding of a figure in the same column of
+    performance.md's current figures for an engine of the same name (its first word)."""
+    current = table_rows(section(performance, "## Current figures"), "| engine | benchmark |")
+    found = []
+    for row in table_rows(section(readme, "## What it costs"), "| engine | against |"):
+        engine = row[0].split()[0]
+        for column, cell in ((2, row[2]), (3, row[3])):
+            known = [float(x) for r in current if r[0].split()[0] == engine
+                     for x in re.findall(r"\d+(?:\.\d+)?", r[column + 1])]
+            for x in re.findall(r"(\d+(?:\.\d+)?)(?=×|–)", cell):
+                digits = len(x.split(".")[1]) if "." in x else 0
+                if not any(round(y, digits) == float(x) for y in known):
+                    found.append(f"README's {engine} {x}×: not in performance.md's current figures ({known})")
+    return found
+
+
+def test_cost_findings_catch_a_figure_that_is_not_the_measured_one():
+    performance = ("## Current figures\n\n| engine | benchmark | against | step timing | exact timing |\n|---|---|---|---|---|\n"
+                   "| YADE 2023 | x | y | 3.4× (3.38-3.54) | 3.4× |\n")
+    readme = "## What it costs\n\n| engine | against | step | exact |\n|---|---|---|---|\n| YADE | y | {} | 3.4× |\n"
+    assert cost_findings(readme.format("3.5×"), performance) == [] and len(cost_findings(readme.format("3.3×"),
+                                                                                        performance)) == 1
+
+
+def test_the_readmes_costs_are_the_current_figures():
+    found = cost_findings((ROOT / "README.md").read_text(), (ROOT / "docs/performance.md").read_text())
+    assert not found, "\n".join(found)
+
+
+def test_yades_current_range_is_its_rows_over_both_runs():
+    """performance.md's current YADE cell gives the ratio's range over the History's two idle
+    runs of the same row (rotation on; rotation on, exact timing), not over other rows."""
+    performance = (ROOT / "docs/performance.md").read_text()
+    history = table_rows(section(performance, "### YADE"), "| case | native | stick-slip | ratio |")
+    runs = {r[0]: sorted(float(x) for x in r[3:5]) for r in history if r[3] and r[4]}
+    yade = next(r for r in table_rows(section(performance, "## Current figures"), "| engine | benchmark |")
+                if r[0].startswith("YADE"))
+    for cell, case in ((yade[3], "rotation on"), (yade[4], 'rotation on, `slip_timing="exact"`')):
+        lo, hi = runs[case]
+        assert f"({lo:.2f}-{hi:.2f} in two runs)" in cell, (cell, case, lo, hi)
+
+
+def test_history_calls_no_figure_current():
+    """A dated measurement stays what it was on its day: only "Current figures" says what holds now."""
+    found = [f"{page}:{n}: {line.strip()[:80]}" for page in HISTORY_PAGES
+             for n, line, history in page_lines(ROOT / page) if history and re.search(r"current figure", line, re.I)]
+    assert not found, "\n".join(found)
