@@ -626,3 +626,192 @@ def test_history_calls_no_figure_current():
     found = [f"{page}:{n}: {line.strip()[:80]}" for page in HISTORY_PAGES
              for n, line, history in page_lines(ROOT / page) if history and re.search(r"current figure", line, re.I)]
     assert not found, "\n".join(found)
+
+
+# --- docs/granular-3d.md against the study's data -------------------------------------------------
+GRANULAR_3D = ROOT / "docs" / "granular-3d.md"
+STUDY = ROOT / "docs" / "granular-3d"
+
+
+def plateau_mu(points):
+    """The least of stock history's mu (LIGGGHTS' map, no rolling resistance) from which no
+    angle (theta_start, theta_stop, theta_heap) differs from its value at any higher mu by two
+    combined standard errors or more: where the angles stop moving with friction."""
+    import pandas as pd
+
+    h = points[(points.engine == "liggghts") & (points.group == "sweep") & (points.mu_s == points.mu_k)
+               & (points["rolling"] == 0)]
+    mus = sorted(h.mu_s.unique())
+    moving = []
+    for target, kind in (("theta_start", "incline"), ("theta_stop", "incline"), ("theta_heap", "heap")):
+        g = h[h.kind == kind].set_index("mu_s")
+        for i, a in enumerate(mus):
+            for b in mus[i + 1:]:
+                z = (g.loc[b, f"{target}_mean"] - g.loc[a, f"{target}_mean"]) / pd.Series(
+                    [g.loc[a, f"{target}_se"], g.loc[b, f"{target}_se"]]).pow(2).sum() ** 0.5
+                if abs(z) >= 2:
+                    moving.append(a)
+    return min(m for m in mus if all(m > x for x in moving))
+
+
+PLATEAU = re.compile(r"stop moving\s+with\s+friction\s+from\s+μs?\s*=\s*(\d\.\d+)")
+LOOSE_PLATEAU = re.compile(r"hardly move|moves? much with|levell?ing off above|μs? ≈ \d\.\d+ (?:the|no) ")
+
+
+def plateau_findings(pages, mu):
+    """Each statement of where the 3D angles stop moving with friction that is not `mu`, or
+    that is not said the one way a test can check."""
+    found = []
+    for page in pages:
+        text = " ".join(t for _, t in prose_lines(page))
+        found += [f"{shown(page)}: 'from μ = {m.group(1)}', the data: {mu}" for m in PLATEAU.finditer(text)
+                  if float(m.group(1)) != mu]
+        found += [f"{shown(page)}: {m.group(0)!r}: say 'stop moving with friction from μ = {mu} on'"
+                  for m in LOOSE_PLATEAU.finditer(text)]
+    return found
+
+
+def test_plateau_findings_catch_each_kind(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("the angles stop moving with\nfriction from μ = 0.65 on; they stop moving with friction from "
+                    "μs = 0.5 on\nabove μs ≈ 0.6 the angles hardly move\n")
+    assert [f.split(": ", 1)[1] for f in plateau_findings([page], 0.65)] == [
+        "'from μ = 0.5', the data: 0.65", "'μs ≈ 0.6 the ': say 'stop moving with friction from μ = 0.65 on'",
+        "'hardly move': say 'stop moving with friction from μ = 0.65 on'"]
+
+
+def test_the_3d_pages_say_where_the_angles_stop_moving_as_the_map_measured_it():
+    import pandas as pd
+
+    mu = plateau_mu(pd.read_csv(STUDY / "points.csv", dtype={"nu_s": str}))
+    pages = [ROOT / "README.md", GRANULAR_3D]
+    assert sum(len(PLATEAU.findall(" ".join(t for _, t in prose_lines(p)))) for p in pages) >= 2
+    found = plateau_findings(pages, mu)
+    assert not found, "\n".join(found)
+
+
+def test_the_studys_size_is_its_runs():
+    """The cost table of docs/granular-3d.md: each group's runs and CPU hours (the runs' wall
+    times summed, to 0.1) are runs.csv's, and so is the total the page states."""
+    import pandas as pd
+
+    runs = pd.read_csv(STUDY / "runs.csv")
+    by_group = runs.groupby("group").agg(runs=("label", "size"), hours=("wall_time_s", lambda s: s.sum() / 3600))
+    rows = table_rows(GRANULAR_3D.read_text(), "| group | what | runs | CPU hours |")
+    stated = {r[0].strip("`"): (int(r[2]), float(r[3])) for r in rows}
+    assert stated.pop("all") == (len(runs), round(runs.wall_time_s.sum() / 3600, 1))
+    assert stated == {g: (int(r.runs), round(r.hours, 1)) for g, r in by_group.iterrows()}
+    assert f"The study is {len(runs)} runs, {runs.wall_time_s.sum() / 3600:.1f} CPU hours" in GRANULAR_3D.read_text()
+
+
+def test_the_pages_sphere_counts_are_the_scenes():
+    """Every "N spheres" on docs/granular-3d.md is a count of the study's scenes (grains that
+    move, fixed ones, the lid's, all of them; the 20 d bed twice the 10 d one's), and the
+    scene descriptions name each scene's own."""
+    from stickslip import scene as scene_mod
+    from stickslip.studies import granular3d, granular3d_tables
+
+    counts = {}
+    for name in ("incline3d", "heap3d", "shear3d"):
+        sc = scene_mod.load(name)
+        counts[name] = {"moving": len(sc.moving_grains()), "fixed": sum(g.fixed for g in sc.grains) - len(
+            sc.lid_grains()), "lid": len(sc.lid_grains()), "all": len(sc.grains)}
+    deep = counts["incline3d"]["moving"] * granular3d.DEEP_LAYERS // granular3d_tables.SCENE_LAYERS
+    allowed = {n for c in counts.values() for n in c.values()} | {deep}
+    text = " ".join(t for _, t in prose_lines(GRANULAR_3D))
+    stated = [int(n.replace(" ", "")) for n in re.findall(r"(?<![\d.])(\d[\d ]*\d|\d) spheres\b", text)]
+    assert stated and not [n for n in stated if n not in allowed], (stated, allowed)
+    for pattern, want in ((r"rough base of (\d+) fixed spheres", counts["incline3d"]["fixed"]),
+                          (r"a bed of (\d+) spheres", counts["incline3d"]["moving"]),
+                          (r"\((\d+) spheres with the base", counts["incline3d"]["all"]),
+                          (r"\((\d+) fixed spheres, the incline's base\)", counts["heap3d"]["fixed"]),
+                          (r"of (\d+) spheres \(19 × 5 × 10", counts["heap3d"]["moving"]),
+                          (r"a heap \((\d+) spheres", counts["heap3d"]["all"]),
+                          (r"a layer of (\d+) spheres", counts["shear3d"]["moving"]),
+                          (r"slab like the base \((\d+)\s+spheres", counts["shear3d"]["lid"]),
+                          (r"(\d+) spheres in all\)", counts["shear3d"]["all"])):
+        got = re.findall(pattern, text)
+        assert got and all(int(g) == want for g in got), (pattern, got, want)
+
+
+# --- the README's quick start against the engine pages --------------------------------------------
+LIGGGHTS_SETTINGS = ("absolute_damping", "limitForce", "slip_reset_total", "exact_slip_timing", "stick_slip_record",
+                     "history_rotation", "history_on_separation", "tangential_damping")
+
+
+def liggghts_lines(text):
+    """{"pair_style gran" | "fix wall/gran": contact settings} of the first such line of a text's
+    code blocks (continued lines joined) with a contact model: the keyword-value pairs of
+    LIGGGHTS_SETTINGS it gives."""
+    blocks = re.findall(r"```[^\n]*\n(.*?)```", text, re.S)
+    out = {}
+    for line in "\n".join(blocks).replace("&\n", " ").splitlines():
+        words = line.split()
+        pair, wall = words[:2] == ["pair_style", "gran"], words[:1] == ["fix"] and "wall/gran" in words[:4]
+        if (pair or wall) and "model" in words:
+            settings = {w: words[i + 1] for i, w in enumerate(words[:-1]) if w in LIGGGHTS_SETTINGS}
+            out.setdefault("pair_style gran" if pair else "fix wall/gran", settings)
+    return out
+
+
+def test_liggghts_lines_are_told_apart():
+    text = ("```\npair_style gran model hooke/stiffness tangential stick_slip absolute_damping on limitForce on\n"
+            "fix floor all wall/gran model hooke/stiffness tangential stick_slip primitive type 1 zplane 0.0 &\n"
+            "    store_force yes absolute_damping on\n```\n")
+    assert liggghts_lines(text) == {"pair_style gran": {"absolute_damping": "on", "limitForce": "on"},
+                                    "fix wall/gran": {"absolute_damping": "on"}}
+
+
+def test_the_readmes_liggghts_lines_use_the_settings_of_its_page():
+    """The README's LIGGGHTS quick start (its pair style and its wall) takes the contact
+    settings of the LIGGGHTS page's first examples of each: a setting left out would give
+    another force (limitForce: no tensile normal force)."""
+    readme = (ROOT / "README.md").read_text()
+    quick = readme.split("**LIGGGHTS.**", 1)[1].split("**LAMMPS", 1)[0]
+    page = (ROOT / "liggghts_plugin/doc/tangential_model_stick_slip.md").read_text()
+    page = section(page, "## Examples")
+    got, want = liggghts_lines(quick), liggghts_lines(page)
+    assert set(got) == {"pair_style gran", "fix wall/gran"} and {k: want[k] for k in got} == got, (got, want)
+
+
+README_LINES = 250  # a front page: what a user needs on its first screens, the rest on the engine pages
+
+
+def test_the_readme_is_a_front_page():
+    assert len((ROOT / "README.md").read_text().splitlines()) <= README_LINES
+
+
+COVERAGE_TARGETS = {"theta_start+theta_stop": "θ_start, θ_stop", "theta_start+theta_stop+theta_heap": "with θ_heap",
+                    "theta_start+theta_stop+shear_peak+shear_steady+shear_dilation": "with the sheared layer"}
+
+
+def coverage_rows(summary):
+    """docs/granular-3d.md's round-trip table as coverage_summary.csv makes it: per set of
+    targets, each range's holds cut / not cut, as stated and widened, the joint region's and
+    the answers on an edge."""
+    widened = summary.widening.max()
+    rows = []
+    for targets, g in summary.groupby("targets", sort=False):
+        g = g.set_index(["widening", "statement", "ranges"])
+
+        def held(w, what):
+            cut, uncut = g.loc[(w, what, "cut")], g.loc[(w, what, "uncut")]
+            return f"{cut.held} of {cut.pairs} / {uncut.held} of {uncut.pairs}"
+        j = g.loc[(1.0, "joint region", "all")]
+        rows.append(f"| {COVERAGE_TARGETS[targets]} | {held(1.0, 'mu_s range')} | {held(widened, 'mu_s range')} | "
+                    f"{held(1.0, 'mu_k range')} | {held(widened, 'mu_k range')} | {j.held} of {j.pairs} "
+                    f"({j.z:+.1f}) | {j.answers_on_map_edge}, {j.answers_on_law_bound} |".replace("-", "−"))
+    return rows
+
+
+def test_the_round_trips_table_is_its_csv():
+    """The coverage table of docs/granular-3d.md, and the widening its header and text state,
+    are coverage_summary.csv's."""
+    import pandas as pd
+
+    summary = pd.read_csv(STUDY / "coverage_summary.csv")
+    page = GRANULAR_3D.read_text()
+    missing = [r for r in coverage_rows(summary) if r not in page]
+    assert not missing, "\n".join(missing)
+    f = f"{summary.widening.max():.2f}"
+    assert f"widened by {f} |" in page and f"f = {f}" in page
