@@ -176,6 +176,34 @@ def test_voice_findings_catch_each_kind():
     assert [int(f.split(":")[0]) for f in got] == [1, 1, 2, 3, 4, 5, 6, 7, 8], got
 
 
+# How a result was found (what was tried and dropped, on whose machine, what a page said before)
+# belongs to the History sections; a page outside them says what is true now. CHANGELOG.md
+# says what each release changed, so it may say what was.
+HOW_IT_WAS_FOUND = re.compile(r"\b(?:measured here|measured and left out|first study|pilots?|shared the machine|"
+                              r"cause (?:was |is )?not found|the former|found here|later pairs)\b", re.IGNORECASE)
+
+
+def how_it_was_found(page):
+    """(line number, phrase) of the notebook's phrases outside a page's History section."""
+    history_lines = {n for n, _, history in page_lines(page) if history}
+    return [(n, m.group(0)) for n, text in prose_without_links(page) if n not in history_lines
+            for m in HOW_IT_WAS_FOUND.finditer(text)]
+
+
+def test_how_it_was_found_is_told_from_what_is_true(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("A row at 0.1 measured and left out.\nSet aside after short pilots.\nThe former gap.\n"
+                    "Its cause was not found.\nThe bed stops at 21.5°.\n")
+    assert [n for n, _ in how_it_was_found(page)] == [1, 2, 3, 4]
+
+
+def test_pages_say_what_is_true_now():
+    """No notebook of how a result was found outside the History sections (CHANGELOG apart)."""
+    found = [f"{shown(page)}:{n}: {phrase!r}" for page in markdown_files() if shown(page) != "CHANGELOG.md"
+             for n, phrase in how_it_was_found(page)]
+    assert not found, "\n".join(found)
+
+
 def test_pages_speak_impersonally():
     found = [f"{page.relative_to(ROOT)}:{f}" for page in markdown_files()
              for f in voice_findings(prose_without_links(page))]
