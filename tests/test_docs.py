@@ -843,3 +843,15 @@ def test_the_round_trips_table_is_its_csv():
     assert not missing, "\n".join(missing)
     f = f"{summary.widening.max():.2f}"
     assert f"widened by {f} |" in page and f"f = {f}" in page
+
+
+def test_the_last_profile_is_the_historys_newest():
+    """docs/testing.md's "last profile" of the suite's CPU time is the newest one its History
+    dates (History's entries are newest first): a newer profile added to History without the
+    paragraph, or the paragraph kept from an older one, would tell two figures apart."""
+    page = (ROOT / "docs/testing.md").read_text()
+    stated = re.search(r"\*\*The last profile\*\*.*?the default\s+suite in ([\d.]+) CPU s", page, re.S)
+    profiles = re.findall(r"STICKSLIP_TEST_CPU`?\)?:?\s*([\d.]+) CPU s|([\d.]+) CPU s\s+\(`STICKSLIP_TEST_CPU`\)",
+                          section(page, "### The suite's run time"))
+    newest = next(a or b for a, b in profiles)
+    assert stated and round(float(stated.group(1))) == round(float(newest)), (stated and stated.group(1), newest)
