@@ -19,7 +19,7 @@ from setuptools.command.build_py import build_py
 MODULES = {"yade_law/stickslip_yade": "stickslip_yade", "deme_model/stickslip_deme.py": "stickslip_deme.py"}
 # repository paths (patterns) copied to stickslip/data/<the same path>
 DATA = ("cases/*.toml", "yade_law/run_scene.py", "deme_model/stick_slip.cu", "docs/granular-3d/points.csv",
-        "docs/granular-3d/validation.csv")
+        "docs/granular-3d/validation.csv", "docs/granular-3d/leave_pair_out.csv")
 
 
 class BuildPyWithShipped(build_py):

@@ -195,6 +195,9 @@ def build_parser():
     cal.add_argument("--rolling", type=float, default=0.0, help="rolling resistance coefficient (epsd2) of the "
                                                                  "material (default: 0)")
     cal.add_argument("--map", type=Path, help="the measured map, points.csv (default: docs/granular-3d/points.csv)")
+    out = cal.add_mutually_exclusive_group()
+    out.add_argument("--details", action="store_true", help="also the statistics behind the answer")
+    out.add_argument("--json", action="store_true", help="the whole answer as JSON (for scripts), nothing else")
 
     rep = sub.add_parser("report", help="run the paper's cases on every available engine; figures + report.md")
     rep.add_argument("--out", type=_folder, default=Path("report"), help="output folder (default: report)")

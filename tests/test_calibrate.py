@@ -6,6 +6,7 @@ figure, and the round trip's coverage machinery (granular3d_calibration.py) on s
 whose answers are known. The committed page's examples: test_granular3d.py."""
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -84,25 +85,58 @@ def test_the_joint_region_is_wider_than_the_profiled_range(synthetic):
     assert 1.0 < r.delta_at(r.mu_s + 1.2 * h, k_best) < calibrate_fit.DELTA_JOINT
 
 
-def _ranges(out, name):
-    text = out.split(f"{name} = ")[1].split("\n")[0]
-    return float(text.split()[0]), [float(v) for v in text.split("profiled: ")[1].split(";")[0].rstrip(")").split(" to ")]
+def _answer(capsys, *argv):
+    """calibrate's whole answer (--json) for these arguments."""
+    assert main(["calibrate", *argv, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
 
 
 def test_a_file_of_repeats_gives_the_mean_and_its_standard_error(tmp_path, capsys):
     """Three repeats of theta_start around 34 (33.6, 34.0, 34.4: se 0.231) and two of theta_stop
-    (20.8, 21.2: se 0.2): the answer is the means', the targets line says what was taken; on a
-    precise map mu_s's range comes from theta_start's 3 repeats alone: Student's t at 2 dof."""
+    (20.8, 21.2: se 0.2): the answer is the means', the targets line of --details says what was
+    taken; on a precise map mu_s's range comes from theta_start's 3 repeats alone: Student's t at
+    2 dof."""
     path = _precise_map(tmp_path)
     (tmp_path / "m.csv").write_text("theta_start,theta_stop\n33.6,20.8\n34.0,21.2\n34.4,\n")
-    assert main(["calibrate", "--measurements", str(tmp_path / "m.csv"), "--map", str(path)]) == 0
+    given = ["--measurements", str(tmp_path / "m.csv"), "--map", str(path)]
+    assert main(["calibrate", *given, "--details"]) == 0
     out = capsys.readouterr().out
     assert "targets: theta_start 34.00 +- 0.23 deg (mean of 3), theta_stop 21.00 +- 0.20 deg (mean of 2)" in out
-    ms, (lo, hi) = _ranges(out, "mu_s")
+    assert "chi2 within (k f)^2 of its least, the other coefficient profiled" in out
+    a = _answer(capsys, *given)
+    (lo, hi), ms = a["mu_s"]["range"], a["mu_s"]["value"]
     assert ms == pytest.approx(0.7, abs=0.005) and lo < 0.7 < hi
-    assert "chi2 within k^2 of its least, the other coefficient profiled" in out
-    k, dof = out.split("errors it comes from: mu_s k ")[1].split(" dof)")[0].split(" (")
-    assert 1.29 < float(k) < 1.33 and 2.0 <= float(dof) < 2.2  # the map's floor (0.05 deg) adds a little
+    assert 1.29 < a["mu_s"]["k"] < 1.33 and 2.0 <= a["mu_s"]["dof"] < 2.2  # the map's floor (0.05 deg) adds a little
+    se = 0.4 / math.sqrt(3)
+    assert a["targets"]["theta_start"] == {"value": pytest.approx(34.0), "se": pytest.approx(se), "n": 3}
+
+
+@pytest.mark.parametrize("lo, hi, shown", [(0.505, 0.645, "0.58 (0.50 to 0.65"), (0.503, 0.893, "0.58 (0.50 to 0.90"),
+                                           (0.5675, 0.5925, "0.580 (0.567 to 0.593"), (0.35, 1.0, "0.6 (0.3 to 1.0"),
+                                           (0.58, 0.58, "0.580 (0.580 to 0.580")])
+def test_the_answer_has_the_digits_its_range_allows(lo, hi, shown):
+    """The value and its range to the decimal of the range's half-width's first significant
+    digit (two digits where it is 1), from 1 to 3 decimals (the grid's step is 0.0025); the
+    range rounded outwards, so that the printed range holds the computed one."""
+    c = {"value": 0.58, "range": [lo, hi], "cut": {"low": None, "high": None}}
+    assert calibrate._coefficient_line("mu_s", c) == f"mu_s = {shown})"
+
+
+def test_the_answer_comes_first_and_only_the_targets_given_are_shown(synthetic, tmp_path, capsys):
+    """The plain answer: mu_s's and mu_k's lines, then one line on what the ranges mean; no
+    statistics (those are --details'), and in --details and --json only the targets given."""
+    path = _synthetic_map(tmp_path)
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--theta-stop-se", "0.3",
+                 "--map", str(path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("mu_s = 0.70") and lines[1].startswith("mu_k = 0.50") and len(lines) == 3
+    assert lines[2].startswith("each range: where its coefficient lies with 68 % confidence, the other left free")
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--map", str(path), "--details"]) == 0
+    out = capsys.readouterr().out
+    assert "the map at the answer: theta_start 34.0 +- " in out and "theta_heap" not in out
+    a = _answer(capsys, "--theta-start", "34", "--theta-stop", "21", "--map", str(path))
+    assert set(a["targets"]) == set(a["map_at_answer"]) == set(a["interpolation"]["own_error"]) == {"theta_start",
+                                                                                                    "theta_stop"}
 
 
 def test_the_range_cut_by_the_maps_edge_is_called_a_bound(tmp_path, capsys):
@@ -112,28 +146,36 @@ def test_the_range_cut_by_the_maps_edge_is_called_a_bound(tmp_path, capsys):
     assert main(["calibrate", "--theta-start", "35.8", "--theta-start-se", "0.6", "--theta-stop", "20.8",
                  "--map", str(path), "--region-png", str(tmp_path / "r.png")]) == 0
     out = capsys.readouterr().out
-    assert "the range reaches the map's edge at mu_s = 0.800: a bound, not a standard error" in out
+    assert "mu_s = 0.79 (0.76 to 0.80; 0.80 is the map's edge, not an uncertainty)" in out
     assert "edge:" not in out  # the answer, 0.79, is inside; only its range reaches the edge
     assert (tmp_path / "r.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f"wrote {tmp_path / 'r.png'}" in out
-    assert main(["calibrate", "--theta-start", "32", "--theta-stop", "26.8", "--theta-stop-se", "0.5",
-                 "--map", str(path)]) == 0
-    assert "the range reaches the law's bound mu_k = mu_s at mu_k = " in capsys.readouterr().out
+    a = _answer(capsys, "--theta-start", "32", "--theta-stop", "26.8", "--theta-stop-se", "0.5", "--map", str(path))
+    assert "mu_k = mu_s" in (a["mu_k"]["cut"]["high"], a["mu_s"]["cut"]["low"])
 
 
-def test_an_answer_on_the_maps_edge_is_told(tmp_path, capsys):
+def test_an_answer_on_the_maps_edge_or_on_a_laws_bound_is_told(tmp_path, capsys):
     """theta_start 36.5 +- 0.6 on the synthetic map (20 + 20 mu_s: 36 at its edge mu_s = 0.8) is
     within 3 standard errors of the map, so it is answered, at mu_s = 0.800, where the map stops:
-    calibrate says that the map does not bracket the answer. An answer on the law's bound mu_k =
-    mu_s (a history contact: theta_stop of mu_k = mu_s) is no edge of the map."""
+    calibrate says that the map does not bracket the answer. An answer on one of the law's bounds
+    is told the same way: theta_stop of mu_k = mu_s (a history contact) and theta_stop below what
+    mu_k = mu_s / 2 gives (15 + 20 (2 mu_k - mu_s): 15 at the bound)."""
     path = _synthetic_map(tmp_path)
     assert main(["calibrate", "--theta-start", "36.5", "--theta-start-se", "0.6", "--theta-stop", "20.8",
                  "--map", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "edge: the least chi2 lies on the map's edge (mu_s 0.800, mu_k " in out and "mu_s = 0.800 (" in out
+    assert "edge: the answer lies on the map's edge (mu_s 0.800, mu_k " in out and "mu_s = 0.80" in out
+    _curved_map(tmp_path, lambda s, k: 20 + 20 * s)  # the dense layout: points on mu_k = mu_s / 2 too
     surf = _surf(path)
-    r = calibrate_fit.solve({"theta_start": calibrate_fit.Target(32.0), "theta_stop": calibrate_fit.Target(27.6, 0.5)},
-                            surf)
-    assert r.mu_k == pytest.approx(r.mu_s) and r.edge is None
+    for stop, bound in ((27.0, "mu_k = mu_s"), (14.6, "mu_k = mu_s / 2")):
+        r = calibrate_fit.solve({"theta_start": calibrate_fit.Target(32.0),
+                                 "theta_stop": calibrate_fit.Target(stop, 0.5)}, surf)
+        assert r.edge == (bound,) and r.mu_k == pytest.approx(r.mu_s if bound == "mu_k = mu_s" else r.mu_s / 2,
+                                                             abs=calibrate_fit.GRID)
+    assert main(["calibrate", "--theta-start", "32", "--theta-stop", "14.6", "--theta-stop-se", "0.5",
+                 "--map", str(path)]) == 0
+    assert "edge: the answer lies on the law's bound mu_k = mu_s / 2 (mu_s 0.600, " in capsys.readouterr().out
+    r = calibrate_fit.solve({"theta_start": calibrate_fit.Target(32.0), "theta_stop": calibrate_fit.Target(21.0)}, surf)
+    assert r.edge == ()
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -165,6 +207,41 @@ def test_bad_calibrate_input_is_one_line_with_status_2(tmp_path, capsys, monkeyp
         code = e.code
     err = capsys.readouterr().err
     assert code == 2 and message in err and err.count("\n") == 1, err
+
+
+def _broken(rows, column, value):
+    rows[column] = rows[column].astype(object)
+    rows.loc[2, column] = value
+    return rows
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda p: p.drop(columns="engine"), "no column 'engine': a map has the columns kind, engine, group"),
+    (lambda p: p.drop(columns=[c for c in p if c.endswith("_mean")]), "no column of a target's mean: expected one of "
+                                                                     "theta_start_mean"),
+    (lambda p: p.drop(columns="theta_stop_se"), "column theta_stop_mean has no theta_stop_se beside it"),
+    (lambda p: _broken(p, "mu_k", "half"), "column mu_k, line 4: 'half': expected a finite number"),
+    (lambda p: _broken(p, "mu_s", np.nan), "column mu_s, line 4: empty: expected a finite number"),
+    (lambda p: _broken(p, "theta_start_mean", "inf"), "column theta_start_mean, line 4: 'inf': expected a finite "
+                                                       "number"),
+    (lambda p: _broken(p, "theta_start_se", np.nan), "column theta_start_se, line 4: empty: expected a finite number "
+                                                      "(the standard error of the mean beside it)"),
+    (lambda p: p.assign(rolling=0.2), "column rolling has no map rows at --rolling 0: it was measured at 0.2 only"),
+    (lambda p: p.assign(engine="lammps"), "no rows with engine 'liggghts' and group 'sweep' or 'shear'"),
+    (None, "cannot be read as CSV"),
+])
+def test_a_malformed_map_is_one_line_naming_the_file_and_column(tmp_path, capsys, change, message):
+    """A map that is not study-3d's points.csv (a column missing or of the wrong type, an empty
+    cell where a number belongs, no rows at the rolling resistance asked) is refused in one
+    line naming the file, the column and what was expected, never a traceback."""
+    path = _synthetic_map(tmp_path)
+    if change is None:
+        path.write_bytes(b"\xff\xfe\x00binary")
+    else:
+        change(pd.read_csv(path, dtype={"nu_s": str})).to_csv(path, index=False)
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--map", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"stickslip: error: --map {path}: ") and message in err and err.count("\n") == 1, err
 
 
 def _curved_map(tmp_path, surface, mus=(0.2, 0.35, 0.5, 0.65, 0.8), se=0.05):
@@ -253,19 +330,25 @@ def test_the_round_trip_holds_the_truth_68_percent_of_the_time_on_a_known_map():
 
 def test_the_study_writes_the_round_trips_tables_per_pair(tmp_path):
     """study-3d's tables of the round trip from points with coverage rows (synthetic series):
-    one row per pair and set of targets, the summary against 68.27 % with the binomial spread
-    of the number of pairs, the map's leave-one-out and the interpolation chosen."""
+    one row per pair, set of targets and widening (1, and the one leave_pair_out.csv measures),
+    the summary against 68.27 % with the binomial spread of the number of pairs, ranges cut by an
+    edge and uncut ones apart, the map's leave-one-out and the interpolation chosen."""
     pts = _coverage_points(np.random.default_rng(1), 8)
     tables = granular3d_calibration.write(tmp_path, pts)
+    f = calibrate_map.widening(pd.read_csv(tmp_path / "leave_pair_out.csv"), 0.0)[0]
     cov = pd.read_csv(tmp_path / "coverage.csv")
-    assert len(cov) == 8 and set(cov.targets) == {"theta_start+theta_stop"} and cov.fills.eq(3).all()
+    assert sorted(set(cov.widening)) == sorted({1.0, f}) and len(cov) == 8 * len(set(cov.widening))
+    assert set(cov.targets) == {"theta_start+theta_stop"} and cov.fills.eq(3).all()
     s = pd.read_csv(tmp_path / "coverage_summary.csv")
-    assert set(s.statement) == {"mu_s range", "mu_k range", "joint region"} and s.pairs.eq(8).all()
+    assert set(s.statement) == {"mu_s range", "mu_k range", "joint region"} and set(s.ranges) == {"all", "cut", "uncut"}
+    whole = s[s.ranges == "all"]
+    assert whole.pairs.eq(8).all() and (s[s.ranges == "cut"].pairs.to_numpy() + s[(s.ranges == "uncut") & (
+        s.statement != "joint region")].pairs.to_numpy() == 8).all()
     assert s.binomial_sd.iloc[0] == pytest.approx(math.sqrt(0.6827 * 0.3173 / 8))
     choice = pd.read_csv(tmp_path / "interpolation.csv")
     assert choice.chosen.sum() == 1 and (tmp_path / "loo.csv").is_file()
     md = granular3d_calibration.markdown(tables)
-    assert "how often its ranges hold the truth" in md and "chosen by leave-one-out" in md
+    assert "how often its ranges hold the truth" in md and "chosen by leave-one-out" in md and "widening" in md
 
 
 def test_targets_that_disagree_on_the_map_are_told(tmp_path, capsys):
@@ -277,13 +360,101 @@ def test_targets_that_disagree_on_the_map_are_told(tmp_path, capsys):
     (0 dof)."""
     path = _synthetic_map(tmp_path)
     given = ["--theta-start", "34", "--theta-start-se", "0.3", "--theta-stop", "21", "--theta-stop-se", "0.3",
-             "--map", str(path)]
+             "--map", str(path), "--details"]
     assert main(["calibrate", *given]) == 0
     assert "agreement:" not in capsys.readouterr().out
     assert main(["calibrate", *given, "--theta-heap", "22.8", "--theta-heap-se", "0.3"]) == 0
-    line = next(t for t in capsys.readouterr().out.splitlines() if t.startswith("agreement:"))
-    assert float(line.split("p = ")[1].split(";")[0]) > 0.5 and "do not agree" not in line
+    out = capsys.readouterr().out
+    line = next(t for t in out.splitlines() if t.startswith("agreement:"))
+    assert float(line.split("p = ")[1]) > 0.5 and "warning:" not in out
     assert main(["calibrate", *given, "--theta-heap", "24.0", "--theta-heap-se", "0.3"]) == 0
-    line = next(t for t in capsys.readouterr().out.splitlines() if t.startswith("agreement:"))
+    out = capsys.readouterr().out
+    line = next(t for t in out.splitlines() if t.startswith("agreement:"))
     chi2 = float(line.split("least chi2 ")[1].split()[0])
-    assert 4.0 < chi2 < 9.0 and "do not agree with each other on the map" in line, line
+    warning = out.splitlines()[3]  # the plain answer's: after mu_s, mu_k and the ranges' line
+    assert 4.0 < chi2 < 9.0 and warning.startswith("warning: the targets do not agree with each other on the map"), out
+
+
+# --- the ranges' widening, measured by leaving the map's own points out ------------------------
+
+def _lpo_rows(ratios, **extra):
+    """leave_pair_out.csv's rows with these mu_s ratios on uncut ranges (mu_k's cut: not counted)."""
+    return pd.DataFrame({"rolling": 0.0, "mu_s_ratio": ratios, "mu_k_ratio": 100.0, "mu_s_cut": "",
+                         "mu_k_cut": "lo: map", "refused": "", **extra})
+
+
+def test_the_widening_makes_68_percent_of_the_uncut_ranges_hold():
+    """Ranges too narrow by a factor s put the truth at a profiled delta chi2 of s^2 chi2(1) over
+    their threshold: the widening, the square root of that ratio's 68.27 % quantile (chi2(1)'s is
+    1), is s, within 4 of the quantile's sampling spreads over 20 000 ranges (0.5 % each: the
+    quantile's sqrt(p (1 - p) / n) over chi2(1)'s density there, 0.242, halved by the root). Ranges
+    that already hold the truth more often are not narrowed; ranges cut by an edge, refused answers
+    and true values off the map's remains do not count."""
+    chi2 = np.random.default_rng(59).chisquare(1, 20000)
+    f, n = calibrate_map.widening(_lpo_rows(1.5 ** 2 * chi2), 0.0)
+    assert f == pytest.approx(1.5, rel=0.02) and n == 20000
+    assert calibrate_map.widening(_lpo_rows(0.5 ** 2 * chi2), 0.0) == (1.0, 20000)
+    rows = pd.concat([_lpo_rows(1.5 ** 2 * chi2), _lpo_rows([1e6] * 4000, refused="x"), _lpo_rows([np.inf] * 100),
+                      _lpo_rows([1e6] * 4000).assign(mu_s_cut="hi: map"), _lpo_rows([1e6] * 4000).assign(rolling=0.1)])
+    assert calibrate_map.widening(rows, 0.0) == (f, 20000)
+    assert calibrate_map.widening(rows, 0.2) == (1.0, 0)
+
+
+def test_a_widened_range_is_wider_by_the_factor(precise):
+    """theta_start linear in mu_s: chi2 is quadratic in mu_s, so widening the threshold by f^2
+    widens mu_s's range by f, to the grid's step."""
+    targets = {"theta_start": calibrate_fit.Target(34.0, 0.4), "theta_stop": calibrate_fit.Target(21.0, 0.5)}
+    plain, wide = calibrate_fit.solve(targets, precise), calibrate_fit.solve(targets, precise, 1.5)
+    assert _half_width(wide, "mu_s") == pytest.approx(1.5 * _half_width(plain, "mu_s"), abs=calibrate_fit.GRID)
+    assert wide.delta["joint"] == plain.delta["joint"] and wide.widen == 1.5
+
+
+def test_leaving_a_point_out_changes_the_linear_map_only_around_it():
+    """The map less one point, by recomputing only the grid points where it had a weight, is the
+    map recomputed whole from the other points (points in general position: one triangulation)."""
+    rng = np.random.default_rng(5)
+    xy = rng.uniform(0, 1, (14, 2))
+    p = calibrate_map.Points(xy, rng.normal(size=14), np.full(14, 0.3), np.full(14, 3.0))
+    at = rng.uniform(-0.1, 1.1, (3000, 2))
+    for method in calibrate_map.METHODS:
+        w = calibrate_map.weights(method, p, at)
+        for i in (0, 5, 13):
+            got, rest = calibrate_map.without(method, p, at, w, i)
+            np.testing.assert_allclose(got, calibrate_map.weights(method, rest, at), atol=1e-12)
+            assert len(rest.mean) == 13
+
+
+def test_leaving_each_point_out_holds_68_percent_on_a_map_with_right_errors(tmp_path):
+    """A planar map measured with a Gaussian spread equal to its stated errors (0.3 deg, known):
+    each point left out and answered by the others holds its truth in its uncut ranges 68.27 % of
+    the time within 3 binomial standard deviations, so the widening stays near 1."""
+    rng = np.random.default_rng(7)
+    rows = []
+    for ms in np.arange(0.2, 0.81, 0.1):
+        for mk in ms * np.array([0.5, 0.625, 0.75, 0.875, 1.0]):
+            rows.append({"kind": "incline", "engine": "liggghts", "group": "sweep", "mu_s": ms, "mu_k": mk,
+                         "nu_s": "paper", "timing": "step", "rolling": 0.0,
+                         "theta_start_mean": 20 + 20 * ms + 0.3 * rng.standard_normal(), "theta_start_se": 0.3,
+                         "theta_stop_mean": 15 + 20 * (2 * mk - ms) + 0.3 * rng.standard_normal(),
+                         "theta_stop_se": 0.3})
+    lpo = granular3d_calibration.leave_pair_out(pd.DataFrame(rows), 0.0)
+    ok = lpo[lpo.refused.fillna("") == ""]
+    ratios = pd.concat([ok.loc[ok[f"{c}_cut"].fillna("") == "", f"{c}_ratio"] for c in ("mu_s", "mu_k")])
+    n, held = len(ratios), int((ratios <= 1).sum())
+    assert n >= 20 and abs(held / n - calibrate_fit.COVER) < 3 * math.sqrt(0.6827 * 0.3173 / n), (held, n)
+
+
+def test_calibrate_widens_its_ranges_by_the_maps_own_measure(tmp_path, capsys):
+    """With leave_pair_out.csv beside the map, calibrate's ranges are widened by the factor it
+    measures (ratios of 4 on every uncut range: f = 2) and it says so."""
+    path = _precise_map(tmp_path)
+    given = ["--theta-start", "34", "--theta-start-se", "0.4", "--theta-stop", "21", "--theta-stop-se", "0.5",
+             "--map", str(path)]
+    plain = _answer(capsys, *given)
+    _lpo_rows([4.0] * 10).to_csv(tmp_path / "leave_pair_out.csv", index=False)
+    wide = _answer(capsys, *given)
+    half = lambda a: (a["mu_s"]["range"][1] - a["mu_s"]["range"][0]) / 2  # noqa: E731
+    assert wide["ranges"]["widened_by"] == 2.0 and wide["ranges"]["widening_from_ranges"] == 10
+    assert half(wide) == pytest.approx(2 * half(plain), abs=calibrate_fit.GRID)
+    assert main(["calibrate", *given]) == 0
+    assert "widened by 2.00 as measured on the map's own points" in capsys.readouterr().out

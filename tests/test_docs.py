@@ -17,6 +17,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from conftest import skip_engine
@@ -117,14 +118,19 @@ def page_lines(page):
         yield n, line, history
 
 
+RELEASE = re.compile(r"^## \[\d+\.\d+\.\d+\] - 20\d\d-[01]\d-[0-3]\d$")  # CHANGELOG.md's release headings
+
+
 def test_user_pages_carry_no_dates_sessions_or_outside_links():
-    """Dates only under '## History' of docs/performance.md and docs/testing.md; work-session
-    talk, notes outside the repository and outside links nowhere."""
+    """Dates only under '## History' of docs/performance.md and docs/testing.md and in
+    CHANGELOG.md's release headings; work-session talk, notes outside the repository and
+    outside links nowhere."""
     found = []
     for page in markdown_files():
         for n, line, history in page_lines(page):
+            dated = history or (shown(page) == "CHANGELOG.md" and RELEASE.match(line))
             for pattern, what in HYGIENE:
-                if pattern.search(line) and not (history and what == "a date"):
+                if pattern.search(line) and not (dated and what == "a date"):
                     found.append(f"{page.relative_to(ROOT)}:{n}: {what}: {line.strip()[:100]}")
     assert not found, "\n".join(found)
 
@@ -168,6 +174,34 @@ def test_voice_findings_catch_each_kind():
                             "lammps/lammps#3022", "for I ≠ J and I..J", "The drag's saw-tooth"], 1))
     got = voice_findings([(n, re.sub(r"`[^`]*`", "``", t)) for n, t in lines])
     assert [int(f.split(":")[0]) for f in got] == [1, 1, 2, 3, 4, 5, 6, 7, 8], got
+
+
+# How a result was found (what was tried and dropped, on whose machine, what a page said before)
+# belongs to the History sections; a page outside them says what is true now. CHANGELOG.md
+# says what each release changed, so it may say what was.
+HOW_IT_WAS_FOUND = re.compile(r"\b(?:measured here|measured and left out|first study|pilots?|shared the machine|"
+                              r"cause (?:was |is )?not found|the former|found here|later pairs)\b", re.IGNORECASE)
+
+
+def how_it_was_found(page):
+    """(line number, phrase) of the notebook's phrases outside a page's History section."""
+    history_lines = {n for n, _, history in page_lines(page) if history}
+    return [(n, m.group(0)) for n, text in prose_without_links(page) if n not in history_lines
+            for m in HOW_IT_WAS_FOUND.finditer(text)]
+
+
+def test_how_it_was_found_is_told_from_what_is_true(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("A row at 0.1 measured and left out.\nSet aside after short pilots.\nThe former gap.\n"
+                    "Its cause was not found.\nThe bed stops at 21.5°.\n")
+    assert [n for n, _ in how_it_was_found(page)] == [1, 2, 3, 4]
+
+
+def test_pages_say_what_is_true_now():
+    """No notebook of how a result was found outside the History sections (CHANGELOG apart)."""
+    found = [f"{shown(page)}:{n}: {phrase!r}" for page in markdown_files() if shown(page) != "CHANGELOG.md"
+             for n, phrase in how_it_was_found(page)]
+    assert not found, "\n".join(found)
 
 
 def test_pages_speak_impersonally():
@@ -445,7 +479,10 @@ def test_deme_example_sets_up_the_drag_as_the_adapter_does():
     assert len(example.log) > 20 and plain(example.log) == plain(run.log)
 
 
-def test_deme_example_reads_the_drag_from_the_record(capsys):
+def drag_as_the_examples_print_it(capsys):
+    """(the printed mean friction ratio, its text, the slips, the slip period in steps) of the
+    drag example, read by DEM-Engine's example from pyref's drag (the LIGGGHTS and LAMMPS
+    examples print the same figures: their tests above)."""
     from conftest import paper_case
     from deme_standin import FakeDeme
 
@@ -457,8 +494,61 @@ def test_deme_example_reads_the_drag_from_the_record(capsys):
     def record(family, name, step):  # the grain's record after `step` steps: pyref's row `step`
         return float(values[name].iat[step]) if name in values else 0.0
     deme_example().main(FakeDeme(record=record))
-    mean, count = mean_ratio(capsys.readouterr().out)
+    out = capsys.readouterr().out
+    mean, count = mean_ratio(out)
+    slip_steps = (df.t[df[f"{c}_slip"] > 0] / sc.dt).round().to_numpy()
+    period = float(np.mean(np.diff(slip_steps)))
+    return mean, re.search(r"mean friction ratio .*?: ([0-9.]+)", out).group(1), count, period
+
+
+def test_deme_example_reads_the_drag_from_the_record(capsys):
+    mean, _, count, _ = drag_as_the_examples_print_it(capsys)
     assert abs(mean - DRAG_MEAN) <= DRAG_TOL and count == DRAG_SLIPS, (mean, count)
+
+
+# A figure of the drag example stated on a page: the mean friction ratio over steps 1001-2500
+# (on a line naming the window or the mean friction ratio) and the slip period in steps.
+DRAG_PAGE_MEAN = re.compile(r"(?:1001-2500|mean friction ratio)\D*?(0\.45\d*)(\.\.\.)?")
+DRAG_PAGE_PERIOD = re.compile(r"period of ~(\d+) steps")
+
+
+def drag_findings(pages, shown_mean, period):
+    """Each page's drag figure that is not what the examples print: a mean friction ratio that
+    is not the printed one to the digits stated ("0.4502..." a prefix of it), a slip period
+    that is not the measured one to the step."""
+    found = []
+    for page in pages:
+        for n, line in enumerate(page.read_text().splitlines(), 1):
+            for m in DRAG_PAGE_MEAN.finditer(line):
+                stated, cut = m.group(1), m.group(2)
+                digits = len(stated.split(".")[1])
+                ok = (shown_mean.startswith(stated) if cut else
+                      digits <= len(shown_mean.split(".")[1]) and round(float(shown_mean), digits) == float(stated))
+                if not ok:
+                    found.append(f"{shown(page)}:{n}: mean {stated}{cut or ''}, the examples print {shown_mean}")
+            for m in DRAG_PAGE_PERIOD.finditer(line):
+                if int(m.group(1)) != round(period):
+                    found.append(f"{shown(page)}:{n}: period ~{m.group(1)} steps, measured {period:.1f}")
+    return found
+
+
+def test_drag_findings_catch_each_kind(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("over steps 1001-2500: 0.45025 (paper)\nthe mean friction ratio, 0.450\n"
+                    "over steps 1001-2500 (0.4505: the dashpot)\n1001-2500: 0.4502... (paper)\n"
+                    "1001-2500: 0.4503... (paper)\na period of ~166 steps\na period of ~165 steps\n")
+    got = [f.split(": ", 1)[1] for f in drag_findings([page], "0.45025", 166.2)]
+    assert got == ["mean 0.4505, the examples print 0.45025", "mean 0.4503..., the examples print 0.45025",
+                   "period ~165 steps, measured 166.2"], got
+
+
+def test_every_page_states_the_drag_as_the_examples_print_it(capsys):
+    """The drag example's mean friction ratio and slip period, wherever a page states them, are
+    the figures the examples print (the printed mean: pyref's drag read as the examples read
+    it, to the five decimals the LAMMPS and DEM-Engine examples print; LIGGGHTS prints more)."""
+    mean, text, _, period = drag_as_the_examples_print_it(capsys)
+    found = drag_findings(markdown_files(), text, period)
+    assert not found, "\n".join(found)
 
 
 def test_deme_example_runs_on_a_gpu(tmp_path):
@@ -491,3 +581,277 @@ def test_calibrate_examples_print_what_the_page_shows(page, command, shown):
     script = Path(sys.executable).parent / "stickslip"
     proc = subprocess.run([str(script), *command.split()[1:]], cwd=ROOT, capture_output=True, text=True)
     assert proc.stdout + proc.stderr == shown, page
+
+
+# --- figures stated on more than one page --------------------------------------------------------
+# A figure measured once and copied: each copy is checked against the table it comes from.
+
+def table_rows(text, header):
+    """The rows (lists of cells) of the markdown table whose header row starts with `header`."""
+    lines = text.splitlines()
+    start = next(i for i, ln in enumerate(lines) if ln.startswith(header))
+    rows = []
+    for ln in lines[start + 2:]:
+        if not ln.startswith("|"):
+            break
+        rows.append([c.strip() for c in ln.strip().strip("|").split("|")])
+    return rows
+
+
+def section(text, heading):
+    """The text of a page's section, from its heading to the next heading of its level."""
+    level = heading.split(" ")[0]
+    part = text.split(heading + "\n", 1)[1]
+    return re.split(rf"^{level} ", part, flags=re.M)[0]
+
+
+def cost_findings(readme, performance):
+    """Each figure of the README's cost table (its step and exact timing cells: "0.98×",
+    "0.98–1.03×", "7× slower") that is no rounding of a figure in the same column of
+    performance.md's current figures for an engine of the same name (its first word)."""
+    current = table_rows(section(performance, "## Current figures"), "| engine | benchmark |")
+    found = []
+    for row in table_rows(section(readme, "## What it costs"), "| engine | against |"):
+        engine = row[0].split()[0]
+        for column, cell in ((2, row[2]), (3, row[3])):
+            known = [float(x) for r in current if r[0].split()[0] == engine
+                     for x in re.findall(r"\d+(?:\.\d+)?", r[column + 1])]
+            for x in re.findall(r"(\d+(?:\.\d+)?)(?=×|–)", cell):
+                digits = len(x.split(".")[1]) if "." in x else 0
+                if not any(round(y, digits) == float(x) for y in known):
+                    found.append(f"README's {engine} {x}×: not in performance.md's current figures ({known})")
+    return found
+
+
+def test_cost_findings_catch_a_figure_that_is_not_the_measured_one():
+    performance = ("## Current figures\n\n| engine | benchmark | against | step timing | exact timing |\n|---|---|---|---|---|\n"
+                   "| YADE 2023 | x | y | 3.4× (3.38-3.54) | 3.4× |\n")
+    readme = "## What it costs\n\n| engine | against | step | exact |\n|---|---|---|---|\n| YADE | y | {} | 3.4× |\n"
+    assert cost_findings(readme.format("3.5×"), performance) == [] and len(cost_findings(readme.format("3.3×"),
+                                                                                        performance)) == 1
+
+
+def test_the_readmes_costs_are_the_current_figures():
+    found = cost_findings((ROOT / "README.md").read_text(), (ROOT / "docs/performance.md").read_text())
+    assert not found, "\n".join(found)
+
+
+def test_yades_current_range_is_its_rows_over_both_runs():
+    """performance.md's current YADE cell gives the ratio's range over the History's two idle
+    runs of the same row (rotation on; rotation on, exact timing), not over other rows."""
+    performance = (ROOT / "docs/performance.md").read_text()
+    history = table_rows(section(performance, "### YADE"), "| case | native | stick-slip | ratio |")
+    runs = {r[0]: sorted(float(x) for x in r[3:5]) for r in history if r[3] and r[4]}
+    yade = next(r for r in table_rows(section(performance, "## Current figures"), "| engine | benchmark |")
+                if r[0].startswith("YADE"))
+    for cell, case in ((yade[3], "rotation on"), (yade[4], 'rotation on, `slip_timing="exact"`')):
+        lo, hi = runs[case]
+        assert f"({lo:.2f}-{hi:.2f} in two runs)" in cell, (cell, case, lo, hi)
+
+
+def test_history_calls_no_figure_current():
+    """A dated measurement stays what it was on its day: only "Current figures" says what holds now."""
+    found = [f"{page}:{n}: {line.strip()[:80]}" for page in HISTORY_PAGES
+             for n, line, history in page_lines(ROOT / page) if history and re.search(r"current figure", line, re.I)]
+    assert not found, "\n".join(found)
+
+
+# --- docs/granular-3d.md against the study's data -------------------------------------------------
+GRANULAR_3D = ROOT / "docs" / "granular-3d.md"
+STUDY = ROOT / "docs" / "granular-3d"
+
+
+def plateau_mu(points):
+    """The least of stock history's mu (LIGGGHTS' map, no rolling resistance) from which no
+    angle (theta_start, theta_stop, theta_heap) differs from its value at any higher mu by two
+    combined standard errors or more: where the angles stop moving with friction."""
+    import pandas as pd
+
+    h = points[(points.engine == "liggghts") & (points.group == "sweep") & (points.mu_s == points.mu_k)
+               & (points["rolling"] == 0)]
+    mus = sorted(h.mu_s.unique())
+    moving = []
+    for target, kind in (("theta_start", "incline"), ("theta_stop", "incline"), ("theta_heap", "heap")):
+        g = h[h.kind == kind].set_index("mu_s")
+        for i, a in enumerate(mus):
+            for b in mus[i + 1:]:
+                z = (g.loc[b, f"{target}_mean"] - g.loc[a, f"{target}_mean"]) / pd.Series(
+                    [g.loc[a, f"{target}_se"], g.loc[b, f"{target}_se"]]).pow(2).sum() ** 0.5
+                if abs(z) >= 2:
+                    moving.append(a)
+    return min(m for m in mus if all(m > x for x in moving))
+
+
+PLATEAU = re.compile(r"stop moving\s+with\s+friction\s+from\s+μs?\s*=\s*(\d\.\d+)")
+LOOSE_PLATEAU = re.compile(r"hardly move|moves? much with|levell?ing off above|μs? ≈ \d\.\d+ (?:the|no) ")
+
+
+def plateau_findings(pages, mu):
+    """Each statement of where the 3D angles stop moving with friction that is not `mu`, or
+    that is not said the one way a test can check."""
+    found = []
+    for page in pages:
+        text = " ".join(t for _, t in prose_lines(page))
+        found += [f"{shown(page)}: 'from μ = {m.group(1)}', the data: {mu}" for m in PLATEAU.finditer(text)
+                  if float(m.group(1)) != mu]
+        found += [f"{shown(page)}: {m.group(0)!r}: say 'stop moving with friction from μ = {mu} on'"
+                  for m in LOOSE_PLATEAU.finditer(text)]
+    return found
+
+
+def test_plateau_findings_catch_each_kind(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("the angles stop moving with\nfriction from μ = 0.65 on; they stop moving with friction from "
+                    "μs = 0.5 on\nabove μs ≈ 0.6 the angles hardly move\n")
+    assert [f.split(": ", 1)[1] for f in plateau_findings([page], 0.65)] == [
+        "'from μ = 0.5', the data: 0.65", "'μs ≈ 0.6 the ': say 'stop moving with friction from μ = 0.65 on'",
+        "'hardly move': say 'stop moving with friction from μ = 0.65 on'"]
+
+
+def test_the_3d_pages_say_where_the_angles_stop_moving_as_the_map_measured_it():
+    import pandas as pd
+
+    mu = plateau_mu(pd.read_csv(STUDY / "points.csv", dtype={"nu_s": str}))
+    pages = [ROOT / "README.md", GRANULAR_3D]
+    assert sum(len(PLATEAU.findall(" ".join(t for _, t in prose_lines(p)))) for p in pages) >= 2
+    found = plateau_findings(pages, mu)
+    assert not found, "\n".join(found)
+
+
+def test_the_studys_size_is_its_runs():
+    """The cost table of docs/granular-3d.md: each group's runs and CPU hours (the runs' wall
+    times summed, to 0.1) are runs.csv's, and so is the total the page states."""
+    import pandas as pd
+
+    runs = pd.read_csv(STUDY / "runs.csv")
+    by_group = runs.groupby("group").agg(runs=("label", "size"), hours=("wall_time_s", lambda s: s.sum() / 3600))
+    rows = table_rows(GRANULAR_3D.read_text(), "| group | what | runs | CPU hours |")
+    stated = {r[0].strip("`"): (int(r[2]), float(r[3])) for r in rows}
+    assert stated.pop("all") == (len(runs), round(runs.wall_time_s.sum() / 3600, 1))
+    assert stated == {g: (int(r.runs), round(r.hours, 1)) for g, r in by_group.iterrows()}
+    assert f"The study is {len(runs)} runs, {runs.wall_time_s.sum() / 3600:.1f} CPU hours" in GRANULAR_3D.read_text()
+
+
+def test_the_pages_sphere_counts_are_the_scenes():
+    """Every "N spheres" on docs/granular-3d.md is a count of the study's scenes (grains that
+    move, fixed ones, the lid's, all of them; the 20 d bed twice the 10 d one's), and the
+    scene descriptions name each scene's own."""
+    from stickslip import scene as scene_mod
+    from stickslip.studies import granular3d, granular3d_tables
+
+    counts = {}
+    for name in ("incline3d", "heap3d", "shear3d"):
+        sc = scene_mod.load(name)
+        counts[name] = {"moving": len(sc.moving_grains()), "fixed": sum(g.fixed for g in sc.grains) - len(
+            sc.lid_grains()), "lid": len(sc.lid_grains()), "all": len(sc.grains)}
+    deep = counts["incline3d"]["moving"] * granular3d.DEEP_LAYERS // granular3d_tables.SCENE_LAYERS
+    allowed = {n for c in counts.values() for n in c.values()} | {deep}
+    text = " ".join(t for _, t in prose_lines(GRANULAR_3D))
+    stated = [int(n.replace(" ", "")) for n in re.findall(r"(?<![\d.])(\d[\d ]*\d|\d) spheres\b", text)]
+    assert stated and not [n for n in stated if n not in allowed], (stated, allowed)
+    for pattern, want in ((r"rough base of (\d+) fixed spheres", counts["incline3d"]["fixed"]),
+                          (r"a bed of (\d+) spheres", counts["incline3d"]["moving"]),
+                          (r"\((\d+) spheres with the base", counts["incline3d"]["all"]),
+                          (r"\((\d+) fixed spheres, the incline's base\)", counts["heap3d"]["fixed"]),
+                          (r"of (\d+) spheres \(19 × 5 × 10", counts["heap3d"]["moving"]),
+                          (r"a heap \((\d+) spheres", counts["heap3d"]["all"]),
+                          (r"a layer of (\d+) spheres", counts["shear3d"]["moving"]),
+                          (r"slab like the base \((\d+)\s+spheres", counts["shear3d"]["lid"]),
+                          (r"(\d+) spheres in all\)", counts["shear3d"]["all"])):
+        got = re.findall(pattern, text)
+        assert got and all(int(g) == want for g in got), (pattern, got, want)
+
+
+# --- the README's quick start against the engine pages --------------------------------------------
+LIGGGHTS_SETTINGS = ("absolute_damping", "limitForce", "slip_reset_total", "exact_slip_timing", "stick_slip_record",
+                     "history_rotation", "history_on_separation", "tangential_damping")
+
+
+def liggghts_lines(text):
+    """{"pair_style gran" | "fix wall/gran": contact settings} of the first such line of a text's
+    code blocks (continued lines joined) with a contact model: the keyword-value pairs of
+    LIGGGHTS_SETTINGS it gives."""
+    blocks = re.findall(r"```[^\n]*\n(.*?)```", text, re.S)
+    out = {}
+    for line in "\n".join(blocks).replace("&\n", " ").splitlines():
+        words = line.split()
+        pair, wall = words[:2] == ["pair_style", "gran"], words[:1] == ["fix"] and "wall/gran" in words[:4]
+        if (pair or wall) and "model" in words:
+            settings = {w: words[i + 1] for i, w in enumerate(words[:-1]) if w in LIGGGHTS_SETTINGS}
+            out.setdefault("pair_style gran" if pair else "fix wall/gran", settings)
+    return out
+
+
+def test_liggghts_lines_are_told_apart():
+    text = ("```\npair_style gran model hooke/stiffness tangential stick_slip absolute_damping on limitForce on\n"
+            "fix floor all wall/gran model hooke/stiffness tangential stick_slip primitive type 1 zplane 0.0 &\n"
+            "    store_force yes absolute_damping on\n```\n")
+    assert liggghts_lines(text) == {"pair_style gran": {"absolute_damping": "on", "limitForce": "on"},
+                                    "fix wall/gran": {"absolute_damping": "on"}}
+
+
+def test_the_readmes_liggghts_lines_use_the_settings_of_its_page():
+    """The README's LIGGGHTS quick start (its pair style and its wall) takes the contact
+    settings of the LIGGGHTS page's first examples of each: a setting left out would give
+    another force (limitForce: no tensile normal force)."""
+    readme = (ROOT / "README.md").read_text()
+    quick = readme.split("**LIGGGHTS.**", 1)[1].split("**LAMMPS", 1)[0]
+    page = (ROOT / "liggghts_plugin/doc/tangential_model_stick_slip.md").read_text()
+    page = section(page, "## Examples")
+    got, want = liggghts_lines(quick), liggghts_lines(page)
+    assert set(got) == {"pair_style gran", "fix wall/gran"} and {k: want[k] for k in got} == got, (got, want)
+
+
+README_LINES = 250  # a front page: what a user needs on its first screens, the rest on the engine pages
+
+
+def test_the_readme_is_a_front_page():
+    assert len((ROOT / "README.md").read_text().splitlines()) <= README_LINES
+
+
+COVERAGE_TARGETS = {"theta_start+theta_stop": "θ_start, θ_stop", "theta_start+theta_stop+theta_heap": "with θ_heap",
+                    "theta_start+theta_stop+shear_peak+shear_steady+shear_dilation": "with the sheared layer"}
+
+
+def coverage_rows(summary):
+    """docs/granular-3d.md's round-trip table as coverage_summary.csv makes it: per set of
+    targets, each range's holds cut / not cut, as stated and widened, the joint region's and
+    the answers on an edge."""
+    widened = summary.widening.max()
+    rows = []
+    for targets, g in summary.groupby("targets", sort=False):
+        g = g.set_index(["widening", "statement", "ranges"])
+
+        def held(w, what):
+            cut, uncut = g.loc[(w, what, "cut")], g.loc[(w, what, "uncut")]
+            return f"{cut.held} of {cut.pairs} / {uncut.held} of {uncut.pairs}"
+        j = g.loc[(1.0, "joint region", "all")]
+        rows.append(f"| {COVERAGE_TARGETS[targets]} | {held(1.0, 'mu_s range')} | {held(widened, 'mu_s range')} | "
+                    f"{held(1.0, 'mu_k range')} | {held(widened, 'mu_k range')} | {j.held} of {j.pairs} "
+                    f"({j.z:+.1f}) | {j.answers_on_map_edge}, {j.answers_on_law_bound} |".replace("-", "−"))
+    return rows
+
+
+def test_the_round_trips_table_is_its_csv():
+    """The coverage table of docs/granular-3d.md, and the widening its header and text state,
+    are coverage_summary.csv's."""
+    import pandas as pd
+
+    summary = pd.read_csv(STUDY / "coverage_summary.csv")
+    page = GRANULAR_3D.read_text()
+    missing = [r for r in coverage_rows(summary) if r not in page]
+    assert not missing, "\n".join(missing)
+    f = f"{summary.widening.max():.2f}"
+    assert f"widened by {f} |" in page and f"f = {f}" in page
+
+
+def test_the_last_profile_is_the_historys_newest():
+    """docs/testing.md's "last profile" of the suite's CPU time is the newest one its History
+    dates (History's entries are newest first): a newer profile added to History without the
+    paragraph, or the paragraph kept from an older one, would tell two figures apart."""
+    page = (ROOT / "docs/testing.md").read_text()
+    stated = re.search(r"\*\*The last profile\*\*.*?the default\s+suite in ([\d.]+) CPU s", page, re.S)
+    profiles = re.findall(r"STICKSLIP_TEST_CPU`?\)?:?\s*([\d.]+) CPU s|([\d.]+) CPU s\s+\(`STICKSLIP_TEST_CPU`\)",
+                          section(page, "### The suite's run time"))
+    newest = next(a or b for a, b in profiles)
+    assert stated and round(float(stated.group(1))) == round(float(newest)), (stated and stated.group(1), newest)

@@ -6,6 +6,7 @@ smoke run and `stickslip calibrate`. The study itself is opt-in (slow)."""
 from __future__ import annotations
 
 import copy
+import json
 import math
 import tomllib
 
@@ -253,14 +254,13 @@ def test_effective_mu_inverts_where_the_stock_curve_reaches_the_angle_once(tmp_p
 def test_calibrate_inverts_the_map(tmp_path, capsys):
     path = _synthetic_map(tmp_path)
     # mu_s = 0.7, mu_k = 0.5: theta_start 34, theta_stop 21, theta_heap 22.8
-    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--map", str(path)]) == 0
-    out = capsys.readouterr().out
-    ms = float(out.split("mu_s = ")[1].split()[0])
-    mk = float(out.split("mu_k = ")[1].split()[0])
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--map", str(path), "--json"]) == 0
+    a = json.loads(capsys.readouterr().out)
+    ms, mk = a["mu_s"]["value"], a["mu_k"]["value"]
     assert ms == pytest.approx(0.7, abs=0.005) and mk == pytest.approx(0.5, abs=0.005)
     # the map's standard error there, over theta_start's slope 20 deg per unit of mu_s, is
     # mu_s's (the other profiled): tests/test_calibrate.py checks it to the grid's step
-    lo, hi = (float(v) for v in out.split("mu_s = ")[1].split("profiled: ")[1].split(")")[0].split(" to "))
+    lo, hi = a["mu_s"]["range"]
     assert 0.005 < hi - ms < 0.03 and 0.005 < ms - lo < 0.03
     assert main(["calibrate", "--theta-stop", "21", "--theta-heap", "22.8", "--map", str(path)]) == 0
 
@@ -281,10 +281,10 @@ def test_calibrate_takes_theta_stop_at_zero_rate(tmp_path, capsys):
     half rate: a lag of 1.0 deg at the ramp's rates), a target theta_stop 1 deg higher gives
     the answer the map as measured gives."""
     _map_with_half_rates(tmp_path)
-    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "22", "--map", str(tmp_path / "points.csv")]) == 0
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "22", "--map", str(tmp_path / "points.csv"),
+                 "--details"]) == 0
     out = capsys.readouterr().out
-    assert float(out.split("mu_s = ")[1].split()[0]) == pytest.approx(0.7, abs=0.005)
-    assert float(out.split("mu_k = ")[1].split()[0]) == pytest.approx(0.5, abs=0.005)
+    assert out.startswith("mu_s = 0.70") and "\nmu_k = 0.50" in out
     assert "theta_stop at zero rate: the ramp's value + 1.0 +- 0.8 deg (its lag, from half rates)" in out
 
 
@@ -295,10 +295,10 @@ def test_calibrate_takes_the_lag_to_fixed_angles_before_the_half_rate_one(tmp_pa
     _map_with_half_rates(tmp_path)
     pd.DataFrame({"engine": ["liggghts", "liggghts", "lammps"], "layers": [36, 18, 18],
                   "fixed_lag": [9.0, 1.5, 7.0], "fixed_lag_se": [0.1, 0.3, 0.1]}).to_csv(tmp_path / "validation.csv")
-    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "22.5", "--map", str(tmp_path / "points.csv")]) == 0
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "22.5", "--map", str(tmp_path / "points.csv"),
+                 "--details"]) == 0
     out = capsys.readouterr().out
-    assert float(out.split("mu_s = ")[1].split()[0]) == pytest.approx(0.7, abs=0.005)
-    assert float(out.split("mu_k = ")[1].split()[0]) == pytest.approx(0.5, abs=0.005)
+    assert out.startswith("mu_s = 0.70") and "\nmu_k = 0.50" in out
     assert "theta_stop at a fixed angle: the ramp's value + 1.5 +- 0.3 deg (its lag to beds held at fixed" in out
 
 
@@ -307,8 +307,8 @@ def test_calibrate_takes_the_lag_to_fixed_angles_before_the_half_rate_one(tmp_pa
     (["--theta-start", "45", "--theta-stop", "21"], "--theta-start 45: outside the measured map, which reaches "
                                                     "theta_start from 24.0 to 36.0 deg"),
     (["--theta-start", "25", "--theta-stop", "30"], "no (mu_s, mu_k) of the map gives these together"),
-    (["--theta-start", "34", "--theta-stop", "21", "--rolling", "0.3"], "--rolling 0.3: the map was measured at "
-                                                                        "rolling resistance 0 only"),
+    (["--theta-start", "34", "--theta-stop", "21", "--rolling", "0.3"], "points.csv: column rolling has no map rows "
+                                                                        "at --rolling 0.3: it was measured at 0 only"),
     (["--theta-start", "95", "--theta-stop", "21"], "must be an angle in degrees, in (0, 90)"),
 ])
 def test_calibrate_refuses_in_one_line_with_status_2(tmp_path, capsys, argv, message):
@@ -375,7 +375,7 @@ def test_the_committed_figures_and_tables_come_from_the_committed_runs(tmp_path)
     shutil.copy(DOCS / "runs.csv", tmp_path / "runs.csv")
     assert main(["study-3d", "--from-csv", "--out", str(tmp_path)]) == 0
     for name in ("points.csv", "predictions.csv", "validation.csv", "engines.csv", "hysteresis.csv", "loo.csv",
-                 "interpolation.csv"):
+                 "interpolation.csv", "leave_pair_out.csv", "coverage.csv", "coverage_summary.csv"):
         got, committed = pd.read_csv(tmp_path / name), pd.read_csv(DOCS / name)
         pd.testing.assert_frame_equal(got, committed, check_exact=False, rtol=1e-9)
     for png in DOCS.glob("*.png"):

@@ -97,6 +97,25 @@ def test_the_citation_is_valid_cff_and_cites_the_software_and_the_paper():
         (2024, 4, "1(78)", 17, 25)
 
 
+def release_dates(changelog):
+    """{version: date} of CHANGELOG.md's release headings ("## [1.0.0] - 2026-11-28"); a
+    release heading without its date maps to None."""
+    return {m.group(1): m.group(2) for m in re.finditer(r"^## \[(\d+\.\d+\.\d+)\](?: - (\d{4}-\d\d-\d\d))?$",
+                                                         changelog, re.M)}
+
+
+def test_every_release_carries_its_date_and_the_citation_that_of_its_version():
+    """Each release in CHANGELOG.md is dated, and CITATION.cff's date-released is the date of
+    the version it cites."""
+    from cffconvert.cli.create_citation import create_citation
+
+    dates = release_dates((ROOT / "CHANGELOG.md").read_text())
+    assert dates and all(dates.values()), dates
+    assert release_dates("## [1.0.0]\n## [0.9.0] - 2026-01-02\n") == {"1.0.0": None, "0.9.0": "2026-01-02"}
+    cff = create_citation(str(ROOT / "CITATION.cff"), None).cffobj
+    assert str(cff["date-released"]) == dates[cff["version"]]
+
+
 def test_the_citation_validation_fails_on_a_broken_file(tmp_path):
     from cffconvert.cli.create_citation import create_citation
 

@@ -11,6 +11,11 @@ with n - 1 degrees of freedom). The map: calibrate_map.py (its points and the in
 that leave-one-out chooses, or --interpolation); the answer and its ranges: calibrate_fit.py.
 The region can be drawn on the map (--region-png, calibrate_region.py).
 
+What it prints: the answer first, each coefficient with as many digits as its range allows and
+its range's ends that are edges (the map's, the law's bounds) said to be such; one line on what
+the ranges mean; a line for an answer on an edge and for targets that disagree. --details adds
+the statistics behind it, --json prints the whole answer (`answer`) for scripts instead.
+
 theta_stop is taken at a fixed angle: the study's ramp measures it while the angle falls, and
 the flow's lag puts it below the angle at which a flow held at a fixed angle stops (the angle
 a user's experiment gives). The lag measured on stock history mu = 0.5, 10 d bed, is added to
@@ -18,6 +23,7 @@ the map's theta_stop, its standard error to the map's (calibrate_map.lag_of).
 """
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -29,6 +35,14 @@ from ..errors import SceneError
 from . import calibrate_fit, calibrate_map
 
 AGREEMENT_P = 0.05  # the least chi2's tail probability below which the targets disagree
+EDGE = {"map": "the map's edge", "mu_k = mu_s": "the law's bound mu_k = mu_s",
+        "mu_k = mu_s / 2": "the law's bound mu_k = mu_s / 2"}
+# What an answer on each edge means: the targets may ask for a pair beyond it.
+BEYOND = {"map": "the map does not bracket it, and the pair the targets ask for may lie beyond the map",
+          "mu_k = mu_s": "stock history, no stick-slip; the targets may ask for mu_k above mu_s, which the law "
+                         "does not allow",
+          "mu_k = mu_s / 2": "a slipping contact holds no force (2 mu_k - mu_s = 0); the targets may ask for mu_k "
+                             "below mu_s / 2, which the law does not allow"}
 
 DOCS = shipped.path("docs/granular-3d")
 TARGETS = calibrate_map.TARGETS
@@ -83,11 +97,11 @@ def targets_of(args):
     return out
 
 
-def prepare(pts, rolling, method="auto", lag=(math.nan, math.nan, None)):
+def prepare(pts, rolling, method="auto", lag=(math.nan, math.nan, None), source="the map"):
     """The surfaces of the map at this rolling resistance, by `method` ("auto": the one of
     smaller leave-one-out error), the interpolation's own error added, and the leave-one-out
     rows they came from."""
-    m = calibrate_map.from_points(pts, rolling)
+    m = calibrate_map.from_points(pts, rolling, source=source)
     rows = calibrate_map.loo(m)
     chosen = calibrate_map.choose(rows) if method == "auto" else method
     err = calibrate_map.interp_error(rows)
@@ -95,36 +109,144 @@ def prepare(pts, rolling, method="auto", lag=(math.nan, math.nan, None)):
     return calibrate_fit.surfaces(m, chosen, interp, lag), rows
 
 
-def _range_line(r, name, other):
-    (lo, hi), value = r.ranges[name], getattr(r, name)
-    text = f"{name} = {value:.3f} (one standard error, {other} profiled: {lo:.3f} to {hi:.3f}"
-    for end, bound in (("lo", lo), ("hi", hi)):
-        where = r.cut.get((name, end))
-        if where == "map":
-            text += f"; the range reaches the map's edge at {name} = {bound:.3f}: a bound, not a standard error"
-        elif where:
-            text += f"; the range reaches the law's bound {where} at {name} = {bound:.3f}: a bound, not a standard error"
+def decimals(lo, hi):
+    """The decimals a range of this width allows: its half-width to one significant digit (two
+    where that digit is 1), from 1 to 3 (the grid's step is 0.0025)."""
+    half = max((hi - lo) / 2, calibrate_fit.GRID)
+    exp = math.floor(math.log10(half))
+    return min(max(-exp + (half / 10 ** exp < 2), 1), 3)
+
+
+def _finite(x):
+    """x for JSON: NaN and infinities as None, numpy's numbers as Python's."""
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite(v) for v in x]
+    if isinstance(x, (float, np.floating)):
+        return float(x) if math.isfinite(x) else None
+    return x.item() if isinstance(x, np.generic) else x
+
+
+def answer(r, targets, surf, rows, lag, path, rolling, widening):
+    """The whole answer as a dict (what --json prints; the text is made from it): each
+    coefficient's value, range and the edges that cut it, the answer's own edges, what the
+    ranges are, the targets, the map at the answer (for the targets given), its interpolation and
+    the theta_stop lag taken."""
+    from scipy.stats import chi2 as chi2_dist
+
+    coefficients = {}
+    for name in ("mu_s", "mu_k"):
+        lo, hi = r.ranges[name]
+        coefficients[name] = {"value": getattr(r, name), "range": [lo, hi],
+                              "cut": {"low": r.cut.get((name, "lo")), "high": r.cut.get((name, "hi"))},
+                              "k": math.sqrt(r.delta[name]) / r.widen, "dof": r.dof[name]}
+    dof = len(targets) - 2
+    s = calibrate_map.scores(rows)
+    return _finite({
+        **coefficients, "fmin_over_fn": 2 * r.mu_k - r.mu_s, "edge": list(r.edge),
+        "ranges": {"confidence": calibrate_fit.COVER, "widened_by": r.widen, "widening_from_ranges": widening[1],
+                   "joint_delta_chi2": r.delta["joint"]},
+        "chi2": r.chi2,
+        "agreement": {"dof": dof, "p": float(chi2_dist.sf(r.chi2, dof))} if dof > 0 else None,
+        "targets": {a: {"value": t.value, "se": t.se, "n": t.n} for a, t in targets.items()},
+        "map_at_answer": {a: {"mean": r.at_best[a][0], "se": r.at_best[a][1]} for a in targets if a in r.at_best},
+        "interpolation": {"method": surf.method, "own_error": {a: surf.interp.get(a, 0.0) for a in targets},
+                          "leave_one_out": {m: v for m, (v, _) in s.items()},
+                          "leave_one_out_points": max((v[1] for v in s.values()), default=0)},
+        "theta_stop_lag": {"value": lag[0], "se": lag[1], "measured_as": lag[2]},
+        "map": str(path), "rolling": rolling})
+
+
+def _number(value, d):
+    return f"{value:.{d}f}"
+
+
+def _coefficient_line(name, c):
+    """"mu_s = 0.58 (0.50 to 0.65; 0.65 is the law's bound mu_k = mu_s / 2, not an uncertainty)":
+    the value to the digits its range allows, the range rounded outwards."""
+    (lo, hi), d = c["range"], decimals(*c["range"])
+    ends = [_number(math.floor(lo * 10 ** d + 1e-6) / 10 ** d, d), _number(math.ceil(hi * 10 ** d - 1e-6) / 10 ** d, d)]
+    text = f"{name} = {_number(c['value'], d)} ({ends[0]} to {ends[1]}"
+    for end, side in zip(ends, ("low", "high")):
+        if c["cut"][side]:
+            text += f"; {end} is {EDGE[c['cut'][side]]}, not an uncertainty"
     return text + ")"
 
 
-def _k(r, name):
-    dof = r.dof[name]
-    return f"k {math.sqrt(r.delta[name]):.2f} ({'known errors' if not math.isfinite(dof) else f'{dof:.1f} dof'})"
+def _ranges_line(a):
+    widened, cover = a["ranges"]["widened_by"], f"{a['ranges']['confidence'] * 100:.0f} %"
+    how = (f", widened by {widened:.2f} as measured on the map's own points" if widened > 1 else
+           "" if a["ranges"]["widening_from_ranges"] else "; not widened: no leave_pair_out.csv beside the map")
+    return (f"each range: where its coefficient lies with {cover} confidence, the other left free (the map's spread, "
+            f"its interpolation's error and the targets' errors{how}); --details: the statistics")
 
 
-def _agreement_line(chi2, dof):
-    """With more targets than the two coefficients, the least chi2 tests whether the targets
-    agree with each other on the map: its tail probability at (targets - 2) degrees of freedom,
-    read as for known errors (errors from a few fills make the tail heavier: a p just below the
-    line is weak evidence)."""
-    from scipy.stats import chi2 as chi2_dist
+def _agreement_text(a):
+    """The agreement line of --details, and the warning of the plain answer where the targets
+    disagree (None where they agree or are only two). With more targets than the two
+    coefficients the least chi2 tests whether they agree with each other on the map: its tail
+    probability at (targets - 2) degrees of freedom, read as for known errors (errors from a few
+    fills make the tail heavier: a p just below the line is weak evidence)."""
+    g = a["agreement"]
+    if not g:
+        return None, None
+    line = (f"agreement: least chi2 {a['chi2']:.2f} at {g['dof']} degree{'s' if g['dof'] > 1 else ''} of freedom "
+            f"(targets less 2), p = {g['p']:.3f}")
+    if g["p"] >= AGREEMENT_P:
+        return line, None
+    return line, (f"warning: the targets do not agree with each other on the map (p = {g['p']:.3f}, below "
+                  f"{AGREEMENT_P}): one may be off, or its error too small, and the ranges are then too narrow")
 
-    p = float(chi2_dist.sf(chi2, dof))
-    text = f"agreement: least chi2 {chi2:.2f} at {dof} degree{'s' if dof > 1 else ''} of freedom (targets less 2), p = {p:.3f}"
-    if p < AGREEMENT_P:
-        text += (f"; below {AGREEMENT_P}: the targets do not agree with each other on the map (one may be off, or "
-                 "its error too small), and the ranges are narrower than they should be")
-    return text
+
+def plain(a):
+    """The answer in plain words: the lines calibrate prints without --details."""
+    lines = [_coefficient_line(n, a[n]) for n in ("mu_s", "mu_k")] + [_ranges_line(a)]
+    lines += [f"edge: the answer lies on {EDGE[e]} (mu_s {a['mu_s']['value']:.3f}, mu_k {a['mu_k']['value']:.3f}): "
+              f"{BEYOND[e]}; read it as a bound" for e in a["edge"]]
+    warning = _agreement_text(a)[1]
+    return lines + ([warning] if warning else [])
+
+
+def _k(c):
+    dof = "known errors" if c["dof"] is None else f"{c['dof']:.1f} dof"
+    return f"k {c['k']:.2f} ({dof})"
+
+
+def details(a):
+    """The statistics behind the answer: the lines --details adds."""
+    unit = lambda name: UNIT.get(name, " deg")  # noqa: E731
+    ranges = a["ranges"]
+    lines = [f"2 mu_k - mu_s = {a['fmin_over_fn']:.3f} (the force a slipping contact holds, over Fn)",
+             "ranges: chi2 within (k f)^2 of its least, the other coefficient profiled; k Student's t at the degrees "
+             f"of freedom of the errors the coefficient comes from (1 for known errors): mu_s {_k(a['mu_s'])}, mu_k "
+             f"{_k(a['mu_k'])}; f = {ranges['widened_by']:.2f}, the widening that makes 68 % of the ranges hold the "
+             "truth when each of the map's points is left out and answered by the others "
+             f"({ranges['widening_from_ranges']} ranges, leave_pair_out.csv); the joint 68 % region of (mu_s, mu_k) "
+             "is chi2 within "
+             f"{ranges['joint_delta_chi2']:.2f} of its least (--region-png draws it)",
+             "targets: " + ", ".join(f"{n} {t['value']:.2f}" + (f" +- {t['se']:.2f}" if t["se"] else "") + unit(n)
+                                     + (f" (mean of {t['n']})" if t["n"] else "" if t["se"] else " (exact)")
+                                     for n, t in a["targets"].items())]
+    agreement = _agreement_text(a)[0]
+    lines += [agreement] if agreement else []
+    i = a["interpolation"]
+    scores = "; ".join(f"{m} {v:.2f}" for m, v in i["leave_one_out"].items() if v is not None)
+    lines += ["the map at the answer: " + ", ".join(f"{n} {v['mean']:.1f} +- {v['se']:.1f}{unit(n)}"
+                                                  for n, v in a["map_at_answer"].items()) + f" (chi2 {a['chi2']:.2f})",
+              f"interpolation: {i['method']}" + (f" (leave-one-out mean (residual/se)^2 on {i['leave_one_out_points']} "
+                                                 f"points: {scores})" if scores else "")
+              + "; its own error, added to the map's and the target's in quadrature: "
+              + ", ".join(f"{n} {e:.2f}{unit(n)}" for n, e in i["own_error"].items()),
+              f"the map: {a['map']}, rolling resistance {a['rolling']:g}, the paper's nu_s (0.8 nu_n), step mode; the "
+              "scenes of docs/granular-3d.md"]
+    lag = a["theta_stop_lag"]
+    if lag["measured_as"] is None:
+        return lines + ["theta_stop as the ramp measured it (the map has no measure of the ramp's lag)"]
+    return lines + [f"theta_stop at {'a fixed angle' if lag['measured_as'] == 'fixed' else 'zero rate'}: the ramp's "
+                    f"value + {lag['value']:.1f} +- {lag['se']:.1f} deg ("
+                    + ("its lag to beds held at fixed angles, measured)" if lag["measured_as"] == "fixed" else
+                       "its lag, from half rates)")]
 
 
 def main(args):
@@ -132,42 +254,18 @@ def main(args):
     path = args.map or DOCS / "points.csv"
     pts = calibrate_map.read_points(path)
     lag = calibrate_map.lag_of(path, pts)
-    surf, rows = prepare(pts, args.rolling, getattr(args, "interpolation", "auto") or "auto", lag)
-    r = calibrate_fit.solve(targets, surf)
-    print(_range_line(r, "mu_s", "mu_k"))
-    print(_range_line(r, "mu_k", "mu_s"))
-    if r.edge:
-        print(f"edge: the least chi2 lies on the map's edge (mu_s {r.mu_s:.3f}, mu_k {r.mu_k:.3f}): the map does not "
-              "bracket the answer, which may lie beyond it; read it as a bound and the region as what the targets allow")
-    print(f"2 mu_k - mu_s = {2 * r.mu_k - r.mu_s:.3f} (the force a slipping contact holds, over Fn)")
-    print(f"ranges: chi2 within k^2 of its least, the other coefficient profiled (each one's own 68 %: k = 1 for known "
-          f"errors), k Student's t at the degrees of freedom of the errors it comes from: mu_s {_k(r, 'mu_s')}, mu_k "
-          f"{_k(r, 'mu_k')}; the joint 68 % region of (mu_s, mu_k) is chi2 within {r.delta['joint']:.2f} of its least"
-          + (" (drawn in --region-png)" if args.region_png else " (--region-png draws it)"))
-    print("targets: " + ", ".join(f"{a} {t.value:.2f}" + (f" +- {t.se:.2f}" if t.se else "") + UNIT.get(a, " deg")
-                                  + (f" (mean of {t.n})" if t.n else "" if t.se else " (exact)")
-                                  for a, t in targets.items()))
-    if len(targets) > 2:
-        print(_agreement_line(r.chi2, len(targets) - 2))
-    s = calibrate_map.scores(rows)
-    score = "; ".join(f"{m} {v:.2f}" for m, (v, _) in s.items() if np.isfinite(v))
-    n = max((v[1] for v in s.values()), default=0)
-    print("the map there: " + ", ".join(f"{a} {v:.1f} +- {e:.1f}" + UNIT.get(a, " deg") for a, (v, e) in
-                                          r.at_best.items())
-          + f" (chi2 {r.chi2:.2f}); interpolation {surf.method}"
-          + (f" (leave-one-out mean (residual/se)^2 on {n} points: {score})" if score else "")
-          + f"; rolling resistance {args.rolling:g}, the paper's nu_s (0.8 nu_n), step mode; the scenes of "
-            "docs/granular-3d.md")
-    print("errors: the map's, its interpolation's own (leave-one-out: " + ", ".join(
-        f"{t} {e:.2f}{UNIT.get(t, ' deg')}" for t, e in surf.interp.items()) + ") and the target's in quadrature")
-    lag_value, lag_se, how = lag
-    print({"fixed": f"theta_stop at a fixed angle: the ramp's value + {lag_value:.1f} +- {lag_se:.1f} deg (its lag to "
-                    "beds held at fixed angles, measured)",
-           "ramp": f"theta_stop at zero rate: the ramp's value + {lag_value:.1f} +- {lag_se:.1f} deg (its lag, from "
-                   "half rates)",
-           None: "theta_stop as the ramp measured it (the map has no measure of the ramp's lag)"}[how])
+    surf, rows = prepare(pts, args.rolling, getattr(args, "interpolation", "auto") or "auto", lag, f"--map {path}")
+    widening = calibrate_map.widening_of(path, args.rolling)
+    r = calibrate_fit.solve(targets, surf, widening[0])
+    a = answer(r, targets, surf, rows, lag, args.map or "docs/granular-3d/points.csv", args.rolling, widening)
     if args.region_png:
         from . import calibrate_region
 
-        print(f"wrote {calibrate_region.draw(r, targets, pts, args.rolling, args.region_png)}")
+        a["region_png"] = str(calibrate_region.draw(r, targets, pts, args.rolling, args.region_png))
+    if getattr(args, "json", False):
+        print(json.dumps(a, indent=2))
+        return r
+    print("\n".join(plain(a) + (details(a) if getattr(args, "details", False) else [])))
+    if args.region_png:
+        print(f"wrote {a['region_png']}")
     return r

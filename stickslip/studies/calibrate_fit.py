@@ -20,7 +20,12 @@ variance it carries at the answer: the map's local slopes). The joint 68.27 % re
 two is chi2 <= least + 2 F(0.6827; 2, nu) (2.30 for known errors, nu -> infinity), nu the
 smaller of the two coefficients'. Both hold where the map is near linear over the region and
 the errors Gaussian; a region that reaches the map's edge or the law's bounds is cut, and its
-range there is a bound, not a standard error (`cut`), which calibrate says.
+range there is a bound, not a standard error (`cut`), which calibrate says. Where they do not
+hold, the ranges' threshold is widened by f^2, f measured by leaving the map's own points out
+(calibrate_widen.py): `solve(..., widen=f)`.
+
+An answer whose grid point touches the map's edge or one of the law's bounds is not bracketed:
+the targets may ask for a pair beyond it (`Result.edge`), which calibrate says.
 """
 from __future__ import annotations
 
@@ -33,7 +38,7 @@ from ..errors import SceneError
 from . import calibrate_map
 
 GRID = 0.0025  # grid step in mu
-COVER = 0.6827  # one standard error of a Gaussian
+COVER = calibrate_map.COVER
 DELTA_PROFILE = 1.0  # one coefficient, the other profiled, known errors: chi2 quantile 0.6827 with 1 dof
 DELTA_JOINT = 2.30  # the pair, known errors: chi2 quantile 0.6827 with 2 dof
 JOINT_LIMIT = 9.0  # least chi2 above which the targets are not reachable together (3 standard errors)
@@ -71,21 +76,31 @@ class Surfaces:
         return (k <= s + 1e-9) & (k >= s / 2 - 1e-9)
 
 
-def surfaces(m, method, interp=None, lag=(math.nan, math.nan, None)):
-    """Each target's (mean, variance, dof) on the grid, from map m (calibrate_map.from_points)
-    by `method`; interp {target: se} added to every prediction's variance (infinite dof); the
-    lag (value, se, how) added to theta_stop (common to every point: its whole variance)."""
+def grid(m):
+    """(mu_s values, mu_k values, the (mu_s, mu_k) of the grid's points in the law's triangle) over
+    the extent of map m's points."""
     xy = np.vstack([p.xy for p in m.values() if len(p.xy)])
     ms = np.round(np.arange(xy[:, 0].min(), xy[:, 0].max() + GRID / 2, GRID) / GRID) * GRID
     mk = np.round(np.arange(xy[:, 1].min(), xy[:, 1].max() + GRID / 2, GRID) / GRID) * GRID
+    tri = Surfaces(ms, mk, {}, "").triangle()
+    gs, gk = np.meshgrid(ms, mk, indexing="ij")
+    return ms, mk, np.column_stack([gs[tri], gk[tri]])
+
+
+def surfaces(m, method, interp=None, lag=(math.nan, math.nan, None), weights=None, on=None):
+    """Each target's (mean, variance, dof) on the grid, from map m (calibrate_map.from_points)
+    by `method`; interp {target: se} added to every prediction's variance (infinite dof); the
+    lag (value, se, how) added to theta_stop (common to every point: its whole variance).
+    weights {target: (w, Points)} on grid `on` (grid(m) of a larger map) stand in for the
+    map's own (calibrate_widen: the map less one of its points)."""
+    ms, mk, at = on or grid(m)
     s = Surfaces(ms, mk, {}, method, dict(interp or {}), lag)
     tri = s.triangle()
-    gs, gk = np.meshgrid(ms, mk, indexing="ij")
-    at = np.column_stack([gs[tri], gk[tri]])
     for target, p in m.items():
+        w, p = (weights or {}).get(target) or (None, p)
         if len(p.mean) < 3:
             continue
-        mean, var, nu = calibrate_map.predict(calibrate_map.weights(method, p, at), p)
+        mean, var, nu = calibrate_map.predict(calibrate_map.weights(method, p, at) if w is None else w, p)
         extra = s.interp.get(target, 0.0) ** 2
         if target == "theta_stop" and math.isfinite(lag[0]):
             mean, extra = mean + lag[0], extra + lag[1] ** 2
@@ -124,19 +139,32 @@ class Result:
     ranges: dict  # {"mu_s": (lo, hi), "mu_k": (lo, hi)}
     cut: dict  # {("mu_s", "lo" | "hi"): "map" | "mu_k = mu_s" | "mu_k = mu_s / 2" (the law's bounds)}
     at_best: dict  # {target: (mean, se)} of the map at the answer
-    delta: dict  # {"mu_s" | "mu_k" | "joint": delta chi2 of its 68.27 %}
+    delta: dict  # {"mu_s" | "mu_k" | "joint": delta chi2 of its 68.27 %; the ranges' widened by widen^2}
     dof: dict  # {"mu_s" | "mu_k": Welch-Satterthwaite degrees of freedom}
-    edge: str | None = None  # "map" when the answer itself lies on the map's edge (not the law's bounds)
+    edge: tuple = ()  # where the answer itself lies on an edge: "map", "mu_k = mu_s", "mu_k = mu_s / 2"
+    widen: float = 1.0  # the factor the ranges were widened by (calibrate_widen)
 
     def delta_at(self, mu_s, mu_k):
         """chi2 - least chi2 at the grid point nearest (mu_s, mu_k) (inf off the map)."""
         i, j = np.abs(self.surf.ms - mu_s).argmin(), np.abs(self.surf.mk - mu_k).argmin()
         return float(self.field[i, j] - self.chi2)
 
+    def profile_at(self, name, value):
+        """chi2 - least chi2 with coefficient `name` at the grid value nearest `value`, the other
+        profiled (its least along that line; inf where the line misses the map): within
+        delta[name], `value` lies in the range."""
+        if name == "mu_s":
+            line = self.field[np.abs(self.surf.ms - value).argmin(), :]
+        else:
+            line = self.field[:, np.abs(self.surf.mk - value).argmin()]
+        return float(line.min() - self.chi2)
 
-def reachable(surf):
-    parts = [f"{a} {np.nanmin(s[0]):.1f}-{np.nanmax(s[0]):.1f}" for a, s in surf.pred.items()]
-    if "theta_start" in surf.pred and "theta_stop" in surf.pred:
+
+def reachable(surf, names):
+    """What the map reaches of the targets `names` (and of theta_start - theta_stop where both are
+    among them), for a refusal."""
+    parts = [f"{a} {np.nanmin(s[0]):.1f}-{np.nanmax(s[0]):.1f}" for a, s in surf.pred.items() if a in names]
+    if {"theta_start", "theta_stop"} <= set(names):
         d = surf.pred["theta_start"][0] - surf.pred["theta_stop"][0]
         parts.append(f"theta_start - theta_stop {np.nanmin(d):.1f}-{np.nanmax(d):.1f}")
     return "reachable: " + ", ".join(parts) + " deg"
@@ -201,10 +229,11 @@ def thresholds(targets, surf, var_nu, best):
     return delta, dof
 
 
-def solve(targets, surf):
-    """Result for {target name: Target} on the surfaces, or SceneError in one line: a target the
-    map does not measure, one outside what it reaches (by more than 3 of its standard errors), or
-    targets no point gives together within 3 standard errors."""
+def solve(targets, surf, widen=1.0):
+    """Result for {target name: Target} on the surfaces, each coefficient's range widened by
+    `widen` (its delta chi2 by widen^2), or SceneError in one line: a target the map does not
+    measure, one outside what it reaches (by more than 3 of its standard errors), or targets no
+    point gives together within 3 standard errors."""
     missing = [a for a in targets if a not in surf.pred]
     if missing:
         what = ("shear3d measurements (stickslip study-3d --groups shear measures them)"
@@ -214,7 +243,7 @@ def solve(targets, surf):
         lo, hi = np.nanmin(surf.pred[a][0]), np.nanmax(surf.pred[a][0])
         if not lo - 3 * t.se <= t.value <= hi + 3 * t.se:
             raise SceneError(f"{OPTION[a]} {t.value:g}: outside the measured map, which reaches {a} from {lo:.1f} to "
-                             f"{hi:.1f} deg ({reachable(surf)})")
+                             f"{hi:.1f} deg ({reachable(surf, targets)})")
     field, var_nu = _chi2(targets, surf)
     best = np.unravel_index(np.argmin(field), field.shape)
     chi2 = float(field[best])
@@ -223,8 +252,9 @@ def solve(targets, surf):
         got = ", ".join(f"{a} {surf.pred[a][0][best]:.1f}" for a in targets)
         raise SceneError(f"{' '.join(f'{OPTION[a]} {t.value:g}' for a, t in targets.items())}: no (mu_s, mu_k) of "
                          f"the map gives these together within 3 standard errors (closest: mu_s {ms:.3f}, mu_k "
-                         f"{mk:.3f}: {got} deg); {reachable(surf)}")
+                         f"{mk:.3f}: {got} deg); {reachable(surf, targets)}")
     delta, dof = thresholds(targets, surf, var_nu, best)
+    delta.update({p: delta[p] * widen ** 2 for p in ("mu_s", "mu_k")})
     inside = np.isfinite(field)
     ranges, cut = {}, {}
     for axis, name, values in ((0, "mu_s", surf.ms), (1, "mu_k", surf.mk)):
@@ -237,20 +267,22 @@ def solve(targets, surf):
                 cut[name, end] = where
     at_best = {a: (float(mean[best]), math.sqrt(var[best])) for a, (mean, var, _) in surf.pred.items()
                if np.isfinite(mean[best])}
-    return Result(ms, mk, chi2, field, surf, ranges, cut, at_best, delta, dof, _answer_edge(surf, inside, best))
+    return Result(ms, mk, chi2, field, surf, ranges, cut, at_best, delta, dof, _answer_edge(surf, inside, best),
+                  widen)
 
 
 def _answer_edge(surf, inside, best):
-    """"map" when a neighbour of the answer's grid point along mu_s or mu_k is off the map (its
-    extent or hull) rather than beyond the law's bounds: the least chi2 is then where the map
-    stops, and the answer may lie beyond it; None inside."""
+    """What the answer's grid point touches, as a tuple: "map" where a neighbour along mu_s or
+    mu_k is off the map (its extent or hull), the law's bound where one is beyond it; the least
+    chi2 is then where the map or the law stops, and the targets may ask for a pair beyond it.
+    () inside."""
+    found = set()
     for axis in (0, 1):
         for step in (-1, 1):
             j = list(best)
             j[axis] += step
-            if _beyond(surf, inside, *j) == "map":
-                return "map"
-    return None
+            found.add(_beyond(surf, inside, *j))
+    return tuple(e for e in ("map", "mu_k = mu_s", "mu_k = mu_s / 2") if e in found)
 
 
 def _edge(surf, region, inside, axis, i, step):

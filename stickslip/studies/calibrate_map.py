@@ -41,6 +41,7 @@ GROUPS = ("sweep", "shear")
 TARGETS = tuple(KIND)
 METHODS = ("linear", "quadratic")
 SE_FLOOR = 0.05  # deg: a point measured once has no se
+COVER = 0.6827  # one standard error of a Gaussian
 QUADRATIC_TERMS = 6
 
 
@@ -57,11 +58,47 @@ class Points:
         return np.where(np.isfinite(self.n) & (self.n > 1), self.n - 1.0, np.inf)
 
 
+# The columns a map must have (points.csv of `stickslip study-3d`): which rows are map points,
+# and where they lie. A target's columns are "<target>_mean", "_se" and, optionally, "_n".
+LABELS = ("kind", "engine", "group", "nu_s", "timing")
+NUMBERS = ("mu_s", "mu_k", "rolling")
+
+
 def read_points(path):
+    """The map's points from a CSV, or SceneError in one line naming the file, the column and
+    what was expected: the columns LABELS and NUMBERS, numbers where numbers belong, no empty
+    cell in NUMBERS, and for every target it has a mean of, that mean's standard error."""
     path = Path(path)
     if not path.is_file():
         raise SceneError(f"--map {path}: not found (stickslip study-3d writes it)")
-    return pd.read_csv(path, dtype={"nu_s": str})
+    try:
+        pts = pd.read_csv(path, dtype={c: str for c in LABELS})
+    except (OSError, ValueError, pd.errors.ParserError) as e:  # (UnicodeDecodeError is a ValueError)
+        raise SceneError(f"--map {path}: cannot be read as CSV ({' '.join(str(e).split())[:120]})") from None
+    missing = [c for c in (*LABELS, *NUMBERS) if c not in pts]
+    if missing:
+        raise SceneError(f"--map {path}: no column {missing[0]!r}: a map has the columns {', '.join(LABELS + NUMBERS)} "
+                         "(points.csv of stickslip study-3d)")
+    means = [t for t in TARGETS if f"{t}_mean" in pts]
+    if not means:
+        raise SceneError(f"--map {path}: no column of a target's mean: expected one of "
+                         f"{', '.join(t + '_mean' for t in TARGETS)}")
+    for t in means:
+        if f"{t}_se" not in pts:
+            raise SceneError(f"--map {path}: column {t}_mean has no {t}_se beside it: expected each mean's standard "
+                             "error")
+    for c in (*NUMBERS, *(f"{t}_{s}" for t in means for s in ("mean", "se", "n") if f"{t}_{s}" in pts)):
+        v = pd.to_numeric(pts[c], errors="coerce")
+        bad = pts[c].notna() & ~np.isfinite(v) | (pts[c].isna() & (c in NUMBERS))
+        if c.endswith("_se"):
+            bad |= pts[c].isna() & pts[c.replace("_se", "_mean")].notna()
+        if bad.any():
+            i = int(np.argmax(bad.to_numpy()))
+            cell = "empty" if pd.isna(pts[c].iloc[i]) else repr(str(pts[c].iloc[i]))
+            raise SceneError(f"--map {path}: column {c}, line {i + 2}: {cell}: expected a finite number"
+                             + (" (the standard error of the mean beside it)" if c.endswith("_se") else ""))
+        pts[c] = v
+    return pts
 
 
 def lag_of(path, pts):
@@ -73,26 +110,78 @@ def lag_of(path, pts):
     how = "ramp" if math.isfinite(lag) else None
     val = Path(path).with_name("validation.csv") if path is not None else None
     if val is not None and val.is_file():
-        v = pd.read_csv(val)
+        try:
+            v = pd.read_csv(val)
+        except (OSError, ValueError, pd.errors.ParserError) as e:
+            raise SceneError(f"{val} (beside --map): cannot be read as CSV "
+                             f"({' '.join(str(e).split())[:120]})") from None
         if "fixed_lag" in v:
+            need = [c for c in ("engine", "layers", "fixed_lag_se") if c not in v]
+            if need:
+                raise SceneError(f"{val} (beside --map): column fixed_lag without {need[0]!r}: expected "
+                                 "validation.csv of stickslip study-3d")
             v = v[(v.engine == "liggghts") & (v.layers == granular3d_tables.SCENE_LAYERS)]
             if len(v) and math.isfinite(v.fixed_lag.iloc[0]):
                 lag, lag_se, how = float(v.fixed_lag.iloc[0]), float(v.fixed_lag_se.iloc[0]), "fixed"
     return lag, lag_se, how
 
 
-def from_points(pts, rolling, nu_s="paper"):
-    """{target: Points}: the map's points on LIGGGHTS at this rolling resistance, history
-    (mu_s = mu_k) and the stick-slip pairs with the chosen nu_s in the step mode, as the
-    ramp measured them (the lag to a fixed angle, common to every point, is added to the
-    predictions: calibrate_fit.surfaces)."""
+def blank(column):
+    """Where a text column of a table read back is empty (a column with no text reads as NaN)."""
+    return column.isna() | column.astype(str).eq("")
+
+
+def widening(rows, rolling):
+    """(f, ranges): the factor by which calibrate's ranges are widened at this rolling
+    resistance, from leave_pair_out.csv's rows (granular3d_calibration.leave_pair_out): the
+    square root of the 68.27 % quantile of the profiled delta chi2 at the true value over the
+    range's threshold, over the ranges not cut by an edge (1 where they hold the truth at least
+    that often already, or where there are none), and how many ranges it comes from. A true
+    value off the map that is left (a corner of the map left out: an infinite ratio) cannot be
+    answered by any range and is left out."""
+    g = rows[np.isclose(rows["rolling"], rolling) & blank(rows.refused)]
+    ratios = np.concatenate([g.loc[blank(g[f"{c}_cut"]), f"{c}_ratio"].to_numpy(float)
+                             for c in ("mu_s", "mu_k")])
+    ratios = ratios[np.isfinite(ratios)]
+    if not len(ratios):
+        return 1.0, 0
+    return math.sqrt(max(float(np.quantile(ratios, COVER)), 1.0)), len(ratios)
+
+
+def widening_of(path, rolling):
+    """widening() from leave_pair_out.csv beside the map, or (1.0, 0) where there is none."""
+    lpo = Path(path).with_name("leave_pair_out.csv")
+    if not lpo.is_file():
+        return 1.0, 0
+    try:
+        rows = pd.read_csv(lpo)
+        return widening(rows, rolling)
+    except (OSError, ValueError, KeyError, pd.errors.ParserError) as e:
+        raise SceneError(f"{lpo} (beside --map): not a leave_pair_out.csv of stickslip study-3d "
+                         f"({type(e).__name__}: {' '.join(str(e).split())[:80]})") from None
+
+
+def map_rows(pts, rolling, nu_s="paper", source="the map"):
+    """The rows of pts that are the map's points on LIGGGHTS at this rolling resistance:
+    history (mu_s = mu_k) and the stick-slip pairs with the chosen nu_s in the step mode.
+    `source` names the map in a refusal."""
     pts = pts[(pts["engine"] == "liggghts") & pts["group"].isin(GROUPS)]
+    if not len(pts):
+        raise SceneError(f"{source}: no rows with engine 'liggghts' and group {' or '.join(map(repr, GROUPS))}: "
+                         "expected the map's points (points.csv of stickslip study-3d)")
     rolls = sorted(pts["rolling"].unique())
     if not any(math.isclose(rolling, r, abs_tol=1e-9) for r in rolls):
-        raise SceneError(f"--rolling {rolling:g}: the map was measured at rolling resistance "
+        raise SceneError(f"{source}: column rolling has no map rows at --rolling {rolling:g}: it was measured at "
                          f"{' and '.join(f'{r:g}' for r in rolls)} only")
     pts = pts[np.isclose(pts["rolling"], rolling)]
-    pts = pts[(pts.mu_s == pts.mu_k) | ((pts.nu_s == nu_s) & (pts.timing == "step"))]
+    return pts[(pts.mu_s == pts.mu_k) | ((pts.nu_s == nu_s) & (pts.timing == "step"))]
+
+
+def from_points(pts, rolling, nu_s="paper", source="the map"):
+    """{target: Points}: each target's map points (map_rows) as the ramp measured them (the
+    lag to a fixed angle, common to every point, is added to the predictions:
+    calibrate_fit.surfaces)."""
+    pts = map_rows(pts, rolling, nu_s, source)
     out = {}
     for target, kind in KIND.items():
         if f"{target}_mean" not in pts or f"{target}_se" not in pts:
@@ -122,6 +211,26 @@ def _hull(xy):
         return None
 
 
+def _locate(tri, at):
+    """(simplex, barycentric coordinates): for each of `at`, the first triangle of the
+    triangulation that holds it (-1: none), within Qhull's 100 ulps, and its coordinates there
+    (one per vertex, in tri.simplices' order). Plain arithmetic: scipy's find_simplex and
+    transform call LAPACK for each triangle, whose threads cost far more than a map's few
+    triangles."""
+    v = tri.points[tri.simplices]  # (triangles, 3 vertices, 2)
+    (ax, ay), (bx, by), (cx, cy) = (v[:, i].T for i in range(3))
+    det = (by - cy) * (ax - cx) + (cx - bx) * (ay - cy)
+    px, py = at[:, :1] - cx, at[:, 1:] - cy  # (points, triangles)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        la = ((by - cy) * px + (cx - bx) * py) / det
+        lb = ((cy - ay) * px + (ax - cx) * py) / det
+    coords = np.stack([la, lb, 1.0 - la - lb], axis=2)
+    eps = 100 * np.finfo(float).eps
+    held = ((coords >= -eps) & (coords <= 1 + eps)).all(axis=2)
+    simplex = np.where(held.any(axis=1), held.argmax(axis=1), -1)
+    return simplex, coords[np.arange(len(at)), np.maximum(simplex, 0)]
+
+
 def weights(method, p, at):
     """(len(at), len(points)) weights w: the prediction at each of `at` is w . mean; rows of
     NaN outside the points' hull or where the method cannot fit these points."""
@@ -129,12 +238,10 @@ def weights(method, p, at):
     tri = _hull(p.xy)
     if tri is None:
         return w
-    simplex = tri.find_simplex(at)
+    simplex, bary = _locate(tri, at)
     inside = simplex >= 0
     if method == "linear":
-        t = tri.transform[simplex[inside]]
-        b = np.einsum("ijk,ik->ij", t[:, :2], at[inside] - t[:, 2])
-        bary = np.column_stack([b, 1.0 - b.sum(axis=1)])
+        bary = bary[inside]
         rows = np.zeros((inside.sum(), len(p.mean)))
         np.put_along_axis(rows, tri.simplices[simplex[inside]], bary, axis=1)
         w[inside] = rows
@@ -146,6 +253,21 @@ def weights(method, p, at):
     cov = np.linalg.inv(a.T @ (a * wt[:, None]))
     w[inside] = _design(at[inside]) @ cov @ (a * wt[:, None]).T
     return w
+
+
+def without(method, p, at, w, i):
+    """(weights at `at` of the map's points less point i, those points) from w = weights(method,
+    p, at): the linear interpolation changes only where point i had a weight (removing a point
+    re-triangulates only the triangles around it), so only those rows are recomputed; the
+    quadratic surface is fitted again."""
+    keep = np.arange(len(p.mean)) != i
+    rest = Points(p.xy[keep], p.mean[keep], p.se[keep], p.n[keep])
+    if method != "linear":
+        return weights(method, rest, at), rest
+    out = w[:, keep].copy()
+    redo = np.nan_to_num(w[:, i]) != 0
+    out[redo] = weights(method, rest, at[redo])
+    return out, rest
 
 
 def predict(w, p):
