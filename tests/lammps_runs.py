@@ -10,6 +10,7 @@ import os
 import re
 import shutil
 import subprocess
+import tempfile
 import time
 from pathlib import Path
 
@@ -47,10 +48,17 @@ def run_lammps(workdir, name, script, exe=None, np_=1, env=None, timeout=600, ch
         full_env.update(serial_mpi_env(workdir))
     else:
         cmd = ["mpirun", "-np", str(np_), "--oversubscribe"] + cmd
-        full_env.update(MPI_ENV)
+        # a session folder of the run's own (short: Open MPI puts sockets in it): mpiruns that
+        # start together in the shared one race to create it ("orte_session_dir failed")
+        session = tempfile.mkdtemp(prefix="ompi-")
+        full_env.update(MPI_ENV, OMPI_MCA_orte_tmpdir_base=session)
     t0 = time.perf_counter()
-    proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, errors="replace",
-                          timeout=timeout, env=full_env)
+    try:
+        proc = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, errors="replace",
+                              timeout=timeout, env=full_env)
+    finally:
+        if np_ > 1:
+            shutil.rmtree(session, ignore_errors=True)
     proc.seconds = time.perf_counter() - t0
     if check:
         assert proc.returncode == 0 and "ERROR" not in proc.stdout, (

@@ -27,24 +27,25 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import needs_engine, skip_engine
+from conftest import skip_engine
 from lammps_runs import CRASH_MARKERS, error_lines, read_dump, run_lammps
 from stickslip.adapters import lammps_granular
 from stickslip.contract import cases as lc, lammps as runners
 
-pytestmark = needs_engine("lammps_granular")  # LAMMPS 2025 built (the plugin is built with it)
+pytestmark = pytest.mark.skipif(lammps_granular.release_missing("lammps-2025") is not None,
+                                reason=f"engine missing: lammps_granular: {lammps_granular.release_missing('lammps-2025')}")
 
 ROOT = Path(__file__).resolve().parent.parent
 # (STICKSLIP_LAMMPS_2025_PLUGIN: another build of the plugin, e.g. a mutant's)
 PLUGIN = Path(os.environ.get("STICKSLIP_LAMMPS_2025_PLUGIN")
               or ROOT / "build" / "lammps_2025_plugin" / "libstickslip_lammps2025.so")
-LMP = lammps_granular.LAUNCHER
+LMP = lammps_granular.launcher("lammps-2025")  # (the plugin is built against 4 Feb 2025)
 
 
 def test_the_plugin_is_built():
     """Where LAMMPS 2025 is built (./run.sh setup's switch; CI), so is the plugin: a missing
     one fails here."""
-    skip_engine("lammps_granular")
+    skip_engine("lammps_granular", lammps_granular.release_missing("lammps-2025"))
     assert PLUGIN.is_file(), f"{PLUGIN} missing: STICKSLIP_SOURCE_BUILDS=lammps-2025 ./run.sh setup builds it"
 
 

@@ -143,7 +143,7 @@ def test_the_user_page_says_what_lammps_page_says():
     names = re.findall(r"GranSubModStyle\(([^,]+),", header)
     assert len(names) == 8 and all(f"`{n}`" in md for n in names)
     assert all(f"/{o}" in rst for o in ("total", "exact", "record"))
-    for rule_md, rule_rst, rule_cpp in (("mu_s/2 ≤ mu_k ≤ μs", r"\mu_s/2 \le \mu_k \le \mu_s", "[mu_s/2, mu_s]"),
+    for rule_md, rule_rst, rule_cpp in (("μs/2 ≤ mu_k ≤ μs", r"\mu_s/2 \le \mu_k \le \mu_s", "[mu_s/2, mu_s]"),
                                         ("`mu_s` = static friction coefficient μs, > 0", r"\mu_s", "mu_s = {} is outside its allowed range: > 0"),
                                         ("≥ 0: the tangential dashpot", "x_{\\gamma,t}", "x_gamma,t = {} is outside its allowed range: >= 0"),
                                         ("stiffness (force/distance units), > 0; or `NULL`", "NULL", "> 0, or NULL")):

@@ -1,11 +1,11 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""`tangential stick_slip` built into LIGGGHTS-PUBLIC 3.8 the LIGGGHTS way (the law's header
+"""`tangential stick_slip` built into LIGGGHTS-PUBLIC 3.8 the LIGGGHTS way (the law's two headers
 copied into src/, then `make auto`: liggghts_plugin/doc/tangential_model_stick_slip.md,
 "Build into LIGGGHTS"; `STICKSLIP_SOURCE_BUILDS=liggghts-public ./run.sh setup` builds it
 into build/liggghts_public/source/src/lmp_auto) must give the plugin's answers
 (build/liggghts_plugin/liggghts-stickslip, against Debian's library) on the same input, to
 the last bit: the thermo output and dumps are written with 17 significant digits and must
-be the same text. The law is the same file in both builds, and the builds' flags
+be the same text. The law is the same two files in both builds, and the builds' flags
 (LIGGGHTS' Makefile.auto: -O2 -funroll-loops; the plugin: -O3 -fno-tree-vectorize
 -fno-math-errno) may not change a floating-point result: no -ffast-math, and no fused
 multiply-add to contract into (x86-64's SSE2; none in lmp_auto, the plugin or Debian's
@@ -32,7 +32,8 @@ from stickslip.adapters.lammps_family import serial_mpi_env
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "liggghts_plugin" / "examples"
-HEADER = ROOT / "liggghts_plugin" / "tangential_model_stick_slip.h"  # the law: the one file copied
+# the law: the two files copied (the LIGGGHTS model and the law's engine-free core)
+HEADERS = (ROOT / "liggghts_plugin" / "tangential_model_stick_slip.h", ROOT / "lammps_plugin" / "granular" / "stick_slip_core.h")
 # (STICKSLIP_LIGGGHTS_PUBLIC: another build of it)
 LMP_AUTO = Path(os.environ.get("STICKSLIP_LIGGGHTS_PUBLIC")
                 or ROOT / "build" / "liggghts_public" / "source" / "src" / "lmp_auto")
@@ -46,10 +47,11 @@ def builds():
     skip_engine("liggghts")  # the plugin and Debian's LIGGGHTS
     if LMP_AUTO.is_file():
         # the build holds the law as it is now (the set-up copies it again when it changed)
-        copy = LMP_AUTO.parent / HEADER.name
-        if not (copy.is_file() and copy.read_bytes() == HEADER.read_bytes()):
-            pytest.fail(f"{copy} is not {HEADER.relative_to(ROOT)}: STICKSLIP_SOURCE_BUILDS={SWITCH} "
-                        "./run.sh setup rebuilds it", pytrace=False)
+        for header in HEADERS:
+            copy = LMP_AUTO.parent / header.name
+            if not (copy.is_file() and copy.read_bytes() == header.read_bytes()):
+                pytest.fail(f"{copy} is not {header.relative_to(ROOT)}: STICKSLIP_SOURCE_BUILDS={SWITCH} "
+                            "./run.sh setup rebuilds it", pytrace=False)
         return
     where = LMP_AUTO.relative_to(ROOT) if LMP_AUTO.is_relative_to(ROOT) else LMP_AUTO
     why = f"{where} missing: STICKSLIP_SOURCE_BUILDS={SWITCH} ./run.sh setup builds it"

@@ -49,8 +49,11 @@ def test_every_tracked_source_file_carries_the_spdx_line():
     files = spdx.tracked_sources()
     assert len(files) > 150 and "run.sh" in files and ".ci/run" in files
     assert {f.rsplit(".", 1)[-1] for f in files} >= {"py", "sh", "cpp", "h", "cu", "txt"}
-    missing = [f for f in files if not spdx.has_tag((ROOT / f).read_text())]
+    missing = [f for f in files if not spdx.has_tag((ROOT / f).read_text(), f)]
     assert not missing, f"no SPDX line (add it: .venv/bin/python tools/spdx.py): {missing}"
+    lammps_form = [f for f in files if f.startswith(spdx.LAMMPS_FORM)]
+    assert lammps_form and not any(spdx.has_tag((ROOT / f).read_text()) for f in lammps_form), \
+        "the sub-model's files carry LAMMPS' banner in LAMMPS' form, not the SPDX line"
 
 
 @pytest.mark.parametrize("name, text, first_lines", [

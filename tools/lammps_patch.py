@@ -135,7 +135,7 @@ def example_logs(lmp):
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     for n in (1, 4):
         log = f"log.{LOG_DATE}.stick_slip.g++.{n}"
-        cmd = [str(lmp), "-in", EXAMPLE.name, "-log", log, "-echo", "both", "-nocite"]
+        cmd = [str(Path(lmp).resolve()), "-in", EXAMPLE.name, "-log", log, "-echo", "both", "-nocite"]
         if n > 1:
             cmd = ["mpirun", "-np", str(n), "--oversubscribe"] + cmd
         subprocess.run(cmd, cwd=EXAMPLE.parent, check=True, capture_output=True, env=env)

@@ -6,7 +6,9 @@
     .venv/bin/python tools/spdx.py FILE ...   # to these files only
     .venv/bin/python tools/spdx.py --check    # list the tracked source files without it; exit 1 if any
 
-Source files: *.py, *.sh, *.cpp, *.h, *.cu, CMakeLists.txt, run.sh and .ci/run. Where the
+Source files: *.py, *.sh, *.cpp, *.h, *.cu, CMakeLists.txt, run.sh and .ci/run, but the files of
+lammps_plugin/granular/ (the LAMMPS sub-model, in LAMMPS' form for LAMMPS' tree: LAMMPS' banner
+states their license, as LAMMPS' contribution rules ask, and --check requires it). Where the
 line goes: Python and shell, a comment after the shebang and coding lines; C, C++ and CUDA,
 the first line of the top comment (after an editor's mode line; a `/*` comment's text moves
 to the next line; a file that starts otherwise gets a `//` line); CMake, the first line.
@@ -35,8 +37,14 @@ def tracked_sources() -> list[str]:
     return [f for f in out.splitlines() if is_source(f) and (ROOT / f).is_file()]
 
 
-def has_tag(text: str) -> bool:
+LAMMPS_FORM = "lammps_plugin/granular/"
+LAMMPS_BANNER = "This software is distributed under\n   the GNU General Public License."
+
+
+def has_tag(text: str, relative: str = "") -> bool:
     # near the top, where the engines put it (a later mention, e.g. in this file's code, does not count)
+    if relative.startswith(LAMMPS_FORM):
+        return LAMMPS_BANNER in "\n".join(text.splitlines()[:12])
     return any(TAG in line for line in text.splitlines()[:5])
 
 
@@ -61,14 +69,14 @@ def with_tag(relative: str, text: str) -> str:
 
 def main(argv: list[str]) -> int:
     if argv == ["--check"]:
-        missing = [f for f in tracked_sources() if not has_tag((ROOT / f).read_text())]
+        missing = [f for f in tracked_sources() if not has_tag((ROOT / f).read_text(), f)]
         print("\n".join(missing) or "every tracked source file has the SPDX line")
         return 1 if missing else 0
     files = [str(Path(f).resolve().relative_to(ROOT)) for f in argv] or tracked_sources()
     for relative in files:
         path = ROOT / relative
         text = path.read_text()
-        if not has_tag(text):
+        if not has_tag(text, relative) and not relative.startswith(LAMMPS_FORM):
             path.write_text(with_tag(relative, text))
             print(f"spdx: {relative}")
     return 0
