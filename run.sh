@@ -211,7 +211,8 @@ patch_lammps_tree() {
     # patch_lammps_tree TOP: the sub-model enters 4 Jul 2026's tree as a pull request would:
     # tools/lammps_patch.py's patch (sources, documentation, example, unit-test cases), written
     # against pristine copies of the files it changes (TOP/pristine, kept from the source) and
-    # applied with patch(1); a changed patch first takes the previous one out again (patch -R).
+    # applied with patch(1); a changed patch first takes the previous one out (the files it added
+    # removed, those it changed restored), whatever was done to them since.
     # Returns 0 when the tree changed.
     local top=$1 src=$1/source f applied=$1/source/.stick_slip.patch
     if [ ! -f "$applied" ]; then
@@ -222,7 +223,11 @@ patch_lammps_tree() {
     fi
     .venv/bin/python tools/lammps_patch.py "$top/pristine" -o "$top/stick_slip.patch"
     cmp -s "$top/stick_slip.patch" "$applied" && return 1
-    [ -f "$applied" ] && patch -d "$src" -p1 -R -s -f < "$applied" >/dev/null
+    if [ -f "$applied" ]; then
+        # the previous patch out: the files it added removed, those it changed from the pristine copies
+        for f in $(sed -n '/^diff --git /{s/.* b\///;h};/^new file mode/{x;p}' "$applied"); do rm -f "$src/$f"; done
+        (cd "$top/pristine" && find . -type f) | while read -r f; do cp "$top/pristine/$f" "$src/$f"; done
+    fi
     patch -d "$src" -p1 -s --dry-run < "$top/stick_slip.patch" >/dev/null
     patch -d "$src" -p1 -s < "$top/stick_slip.patch" >/dev/null
     cp "$top/stick_slip.patch" "$applied"

@@ -105,7 +105,7 @@ template <class Sub> void set_allow_synchronization(Sub *sub, int flag)
 }
 
 // turn v into the plane normal to the unit vector n, keeping its length
-template <class Sub> void rotate_rescale(Sub *sub, double *v, double *n)
+template <class Sub> STICK_SLIP_ALWAYS_INLINE void rotate_rescale(Sub *sub, double *v, double *n)
 {
   if constexpr (HasRotateRescale<Sub>::value) {
     sub->rotate_rescale_vec(v, n);
@@ -231,17 +231,21 @@ void GranSubModTangentialStickSlip::report_record(const double *history)
 
 /* ---------------------------------------------------------------------- */
 
-void GranSubModTangentialStickSlip::calculate_forces()
+template <int OPTIONS> void GranSubModTangentialStickSlip::forces()
 {
-  // (the contact's vectors in locals: a store through history could alias the model's
-  // arrays, and the compiler would load them again after each)
+  constexpr bool reset_total = OPTIONS & TOTAL, exact_timing = OPTIONS & EXACT,
+                 record = OPTIONS & RECORD;
+
   damp = xt * gm->damping_model->get_damp_prefactor();    // nu_s
   const double fncrit = gm->normal_model->get_fncrit();
   const double Fscrit = fncrit * mu;
   const double ks = mindlin ? k * gm->contact_radius : k;
+  // the spring D is the history's first 3 values, worked on in place (as linear_history's);
+  // V_s in locals (a store through the history pointer could alias the model's arrays, and
+  // the compiler would load them again after each)
   double *history = &gm->history[history_index];
+  double *D = history;
   const double v[3] = {gm->vtr[0], gm->vtr[1], gm->vtr[2]};    // V_s, eq. 6
-  double D[3] = {history[0], history[1], history[2]};
   const double before2 = record ? lensq3(D) : 0.0;
   double *fs = gm->fs;
 
@@ -289,26 +293,36 @@ void GranSubModTangentialStickSlip::calculate_forces()
   }
   for (int i = 0; i < 3; i++) F[i] = -ks * D[i] + fdamp[i];
 
-  // the slip test, then eq. 8 or exact timing (stick_slip_core.h)
-  const double magfs = len3(F), fmin = fncrit * kin;
-  int slipped = StickSlipCore::slips(magfs, Fscrit);
-  if (exact_timing) {
-    double stick;
-    slipped = StickSlipCore::exact_step(slipped, F, D, v, ks, damp, update ? gm->dt : 0.0, Fscrit,
-                                        fmin, ratio, reset_total, stick);
-  } else if (slipped) {
-    if (lensq3(D) != 0.0) {
-      // the force drops to Fmin along the trial force (rescaled as the host's stock does)
-      scale3(magfs > 0.0 ? rescale_factor(gm, fmin, magfs) : 0.0, F);
-      StickSlipCore::reset(F, fdamp, ks, reset_total, D);
-    } else {
-      // as linear_history: a zero spring (a new contact in a set-up evaluation) gets no
-      // tangential force when the dashpot alone reaches the threshold
-      zero3(F);
+  // the slip test, then eq. 8 (stick_slip_core.h); with exact timing the slip test of the
+  // step's end in squares (no square root: the step timing's rescale needs |F|, this does not)
+  int slipped = 0;
+  if constexpr (exact_timing) {
+    // most contacts stick through the step: |F| + Ks dt |V_s| bounds the trial force at both
+    // of its ends (|V_s| is the host's vrel), so below the threshold by more than round-off
+    // no slip happens and E0 need not build the step's start force
+    const double dt = update ? gm->dt : 0.0, mag2 = lensq3(F);
+    if (!(sqrt(mag2) + ks * dt * gm->vrel < Fscrit * (1.0 - 1e-14))) {
+      double stick;
+      slipped =
+          StickSlipCore::exact_step(StickSlipCore::slips(mag2, Fscrit * Fscrit), F, D, v, ks, damp,
+                                    dt, Fscrit, fncrit * kin, ratio, reset_total, stick);
+    }
+  } else {
+    const double magfs = len3(F);
+    slipped = StickSlipCore::slips(magfs, Fscrit);
+    if (slipped) {
+      if (lensq3(D) != 0.0) {
+        // the force drops to Fmin along the trial force (rescaled as the host's stock does)
+        scale3(magfs > 0.0 ? rescale_factor(gm, fncrit * kin, magfs) : 0.0, F);
+        StickSlipCore::reset(F, fdamp, ks, reset_total, D);
+      } else {
+        // as linear_history: a zero spring (a new contact in a set-up evaluation) gets no
+        // tangential force when the dashpot alone reaches the threshold
+        zero3(F);
+      }
     }
   }
 
-  copy3(D, history);
   copy3(F, fs);
   if (record) {
     if (update) {
@@ -321,4 +335,42 @@ void GranSubModTangentialStickSlip::calculate_forces()
     copy3(F, &history[HIST_FS]);
     if (gm->calculate_svector) report_record(history);
   }
+}
+
+/* ---------------------------------------------------------------------- */
+
+void GranSubModTangentialStickSlip::calculate_forces()
+{
+  forces<0>();
+}
+
+// each variant compiled with its options as constants, so that a contact's force tests none of
+// them (a contact-step that reads them at run time takes more instructions: docs/performance.md)
+void GranSubModStickSlipRecord::calculate_forces()
+{
+  forces<RECORD>();
+}
+void GranSubModStickSlipExact::calculate_forces()
+{
+  forces<EXACT>();
+}
+void GranSubModStickSlipExactRecord::calculate_forces()
+{
+  forces<EXACT | RECORD>();
+}
+void GranSubModStickSlipTotal::calculate_forces()
+{
+  forces<TOTAL>();
+}
+void GranSubModStickSlipTotalRecord::calculate_forces()
+{
+  forces<TOTAL | RECORD>();
+}
+void GranSubModStickSlipTotalExact::calculate_forces()
+{
+  forces<TOTAL | EXACT>();
+}
+void GranSubModStickSlipTotalExactRecord::calculate_forces()
+{
+  forces<TOTAL | EXACT | RECORD>();
 }

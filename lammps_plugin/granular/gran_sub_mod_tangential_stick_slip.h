@@ -54,6 +54,9 @@ namespace Granular_NS {
     double ratio;    // kin / mu_s
 
     void report_record(const double *);
+    // the force for one contact, the options as compile-time constants (each variant's
+    // calculate_forces)
+    template <int OPTIONS> void forces();
   };
 
   /* ----------------------------------------------------------------------
@@ -64,42 +67,49 @@ namespace Granular_NS {
    public:
     GranSubModStickSlipRecord(class GranularModel *gm, class LAMMPS *lmp) :
         GranSubModTangentialStickSlip(gm, lmp, RECORD){};
+    void calculate_forces() override;
   };
 
   class GranSubModStickSlipExact : public GranSubModTangentialStickSlip {
    public:
     GranSubModStickSlipExact(class GranularModel *gm, class LAMMPS *lmp) :
         GranSubModTangentialStickSlip(gm, lmp, EXACT){};
+    void calculate_forces() override;
   };
 
   class GranSubModStickSlipExactRecord : public GranSubModTangentialStickSlip {
    public:
     GranSubModStickSlipExactRecord(class GranularModel *gm, class LAMMPS *lmp) :
         GranSubModTangentialStickSlip(gm, lmp, EXACT | RECORD){};
+    void calculate_forces() override;
   };
 
   class GranSubModStickSlipTotal : public GranSubModTangentialStickSlip {
    public:
     GranSubModStickSlipTotal(class GranularModel *gm, class LAMMPS *lmp) :
         GranSubModTangentialStickSlip(gm, lmp, TOTAL){};
+    void calculate_forces() override;
   };
 
   class GranSubModStickSlipTotalRecord : public GranSubModTangentialStickSlip {
    public:
     GranSubModStickSlipTotalRecord(class GranularModel *gm, class LAMMPS *lmp) :
         GranSubModTangentialStickSlip(gm, lmp, TOTAL | RECORD){};
+    void calculate_forces() override;
   };
 
   class GranSubModStickSlipTotalExact : public GranSubModTangentialStickSlip {
    public:
     GranSubModStickSlipTotalExact(class GranularModel *gm, class LAMMPS *lmp) :
         GranSubModTangentialStickSlip(gm, lmp, TOTAL | EXACT){};
+    void calculate_forces() override;
   };
 
   class GranSubModStickSlipTotalExactRecord : public GranSubModTangentialStickSlip {
    public:
     GranSubModStickSlipTotalExactRecord(class GranularModel *gm, class LAMMPS *lmp) :
         GranSubModTangentialStickSlip(gm, lmp, TOTAL | EXACT | RECORD){};
+    void calculate_forces() override;
   };
 
 }    // namespace Granular_NS

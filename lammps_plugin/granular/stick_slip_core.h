@@ -101,7 +101,9 @@ class StickSlipCore {
     if (!(end_slips || start_slips)) return false;
     stick = 0.0;
     const double vs2 = dot(vs, vs), damp2 = nu_s * nu_s;
-    if (start_slips && T > 0.0 && !total && damp2 * vs2 > 0.0 &&
+    // (|Fmin t0 + nu_s |V_s| u| <= Fmin + nu_s |V_s|: E4 needs nu_s |V_s| >= T - Fmin first)
+    if (start_slips && T > 0.0 && !total && damp2 * vs2 >= (T - fmin) * (T - fmin) &&
+        damp2 * vs2 > 0.0 &&
         (fmin * fmin + damp2 * vs2 - T * T) * std::sqrt(start2) - 2.0 * fmin * nu_s * dot(F0, vs) >=
             0.0) {
       // E4 at the step's start, the common slipping case of a flowing bed: the force is at or

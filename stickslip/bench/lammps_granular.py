@@ -85,8 +85,8 @@ TANGENTIAL = {  # a configuration: its tangential sub-model's words (pair and wa
 STOCK = {"ks_step": "linear_history", "ks_exact": "linear_history", "null_step": "mindlin", "null_exact": "mindlin"}
 TARGET = {"ks_step": 1.02, "ks_exact": 1.05, "null_step": 1.02, "null_exact": 1.05}
 # callgrind: own instructions of the functions whose names hold one of the patterns
-GROUPS = {"model": ("PairGranular::", "FixWallGran", "GranularModel::", "GranSubMod", "stickslip::"),
-          "tangential": ("GranSubModTangential", "stickslip::")}
+GROUPS = {"model": ("PairGranular::", "FixWallGran", "GranularModel::", "GranSubMod", "StickSlipCore::"),
+          "tangential": ("GranSubModTangential", "StickSlipCore::")}
 
 SETTLE = """\
 units lj
