@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later
    stickslip: counts of the paths through tangential stick_slip, for the cost analysis of
-   issue 32 (where a contact-step's time goes). Off in the default build: the law's header
-   then leaves this file out and defines STICK_SLIP_COUNT as nothing. Built with
-   `cmake -DSTICK_SLIP_PATH_COUNTS=ON` (a separate build directory;
-   stickslip/bench/liggghts_paths.py does it), every path taken by an evaluation that updates
+   where a contact-step's time goes (stickslip/bench/liggghts_paths.py). Never in the default
+   build: the law's files carry no counter; the analysis build (liggghts_variants.py) writes
+   copies of them with a STICK_SLIP_COUNT statement on each path and this file included,
+   and is configured with `-DSTICK_SLIP_PATH_COUNTS=ON`. Every path taken by an evaluation that updates
    the history adds one to its counter, and the counts are written when the program ends, one
    "name count" line each, to the file named by the environment variable
    STICK_SLIP_PATH_COUNTS (else stderr). */

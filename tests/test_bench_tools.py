@@ -244,3 +244,18 @@ def test_lammps_granular_bench_swaps_only_the_tangential_words_and_divides_each_
         assert "the 4 quiet rounds of 5" in row(c, "time")["case"]
         assert row(c, "busy rounds")["value"] == pytest.approx(3 * expect, rel=1e-12)
         assert row(c, "instructions")["value"] == " / ".join([f"{expect:.4f}"] * 3)
+
+
+def test_the_analysis_builds_find_their_places_in_the_law():
+    """The LIGGGHTS analysis variants are made from the law's files as they read now: each
+    path's counter finds its one line (law or core) and the control replaces the law's class;
+    the LAMMPS path markers find theirs. A law edited without them fails here."""
+    from stickslip.bench import lammps_paths, liggghts_variants as lv
+
+    counted = lv.headers("paths")
+    for name, file, anchor, where, statement in lv.COUNTS:
+        assert statement.splitlines()[0] in counted[file.name], name
+    assert all(t.startswith('#include "stick_slip_path_counts.h"') for t in counted.values())
+    control = lv.headers("control")[lv.LAW.name]
+    assert lv.CONTROL_CLASS in control and "StickSlipCore::" not in control
+    assert len(lammps_paths.marker_lines()) == sum(len(m) for m in lammps_paths.MARKERS.values())

@@ -55,23 +55,24 @@ MARKERS = {
     },
     "stick_slip_law.h": {
         "const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;": "step: slip (reset to Fmin)",
-        "if (start2 >= limit * limit && limit > 0.0 && !s.reset_total": "exact: a slip in the step (E4 tested)",
-        "F[k] = -a * vtr[k];": "exact: E4 at the step's start (slides)",
-        "exact_general(s, c, limit, fmin, v, nu_s, dt, f0, f, d);": "exact: general case",
     },
-    "granular/exact_slip_timing.h": {
-        "const double speed = std::sqrt(dot3(vs, vs));": "exact_slips: every call",
+    "granular/stick_slip_core.h": {
+        "const double start2 = dot(F0, F0);": "exact: every evaluation (E0)",
+        "if (start_slips && T > 0.0 && !total": "exact: a slip in the step (E4 tested)",
+        "F[i] = -a * vs[i];": "exact: E4 at the step's start (slides)",
+        "exact_slips(f0, v, T, fmin, ratio, ks, nu_s, dt, total,": "exact: general case",
+        "const double speed = std::sqrt(dot(vs, vs));": "exact_slips: every call",
         "applied[k] = 0.0;": "E1 (Fn = 0)",
-        "const double f = dot3(F, u), F2 = dot3(F, F);": "E2 (next slip sought)",
+        "const double f = dot(F, u), F2 = dot(F, F);": "E2 (next slip sought)",
         "for (int k = 0; k < 3; k++) applied[k] = trial[k] = F[k] + (rate * rest) * u[k];": "sticks to the step's end",
         "slips++;": "E3 (a slip)",
         "trial[k] = (fmin + kept) * u[k];": "E4 after a slip",
         "plastic_flow(F, u, rate * rest / T, T);": "E6 (plastic flow)",
-        "const double fu = dot3(F, u);": "E5/E6/E7 tests",
+        "const double fu = dot(F, u);": "E5/E6/E7 tests",
         "const double n = std::floor(rest / L);": "E7 (closed form)",
     },
 }
-LAW_FILES = re.compile(r"lammps_plugin/(stick_slip_law\.h|granular/exact_slip_timing\.h|wall_contact\.h|"
+LAW_FILES = re.compile(r"lammps_plugin/(stick_slip_law\.h|granular/stick_slip_core\.h|wall_contact\.h|"
                        r"pair_gran_hooke_stickslip\.cpp|fix_wall_gran_stickslip\.cpp)$")
 STOCK = re.compile(r"PairGranHookeHistory::compute|FixWallGran::(post_force|hooke_history)")
 
