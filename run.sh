@@ -270,22 +270,26 @@ install_packages() {
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >/dev/null
 }
 
+setup_lammps_bigbig() {
+    # the patched 4 Jul 2026 tree again, built with LAMMPS' 64-bit sizes (lmp only)
+    [ -f build/lammps_2026/bigbig/CMakeCache.txt ] || \
+        cmake -S build/lammps_2026/source/cmake -B build/lammps_2026/bigbig \
+              -C build/lammps_2026/source/cmake/presets/all_off.cmake -D PKG_GRANULAR=on -D BUILD_MPI=on \
+              -D LAMMPS_SIZES=BIGBIG -D BUILD_OMP=off -D CMAKE_BUILD_TYPE=Release >/dev/null
+    cmake --build build/lammps_2026/bigbig -j "$(nproc)" --target lmp >/dev/null
+}
+
 setup_lammps_modern() {
     local entry word
     for entry in $LAMMPS_RELEASES; do
         word=${entry%%:*}
-        wants_source_build "$word" && setup_lammps_release "$word"
+        if wants_source_build "$word"; then timed "$word" setup_lammps_release "$word"; fi
     done
     if wants_source_build lammps-2026-bigbig; then
-        wants_source_build lammps-2026 || setup_lammps_release lammps-2026
-        # the patched tree again, built with LAMMPS' 64-bit sizes (lmp only)
-        [ -f build/lammps_2026/bigbig/CMakeCache.txt ] || \
-            cmake -S build/lammps_2026/source/cmake -B build/lammps_2026/bigbig \
-                  -C build/lammps_2026/source/cmake/presets/all_off.cmake -D PKG_GRANULAR=on -D BUILD_MPI=on \
-                  -D LAMMPS_SIZES=BIGBIG -D BUILD_OMP=off -D CMAKE_BUILD_TYPE=Release >/dev/null
-        cmake --build build/lammps_2026/bigbig -j "$(nproc)" --target lmp >/dev/null
+        if ! wants_source_build lammps-2026; then timed lammps-2026 setup_lammps_release lammps-2026; fi
+        timed lammps-2026-bigbig setup_lammps_bigbig
     fi
-    wants_source_build lammps-2026 && setup_lammps_docs
+    if wants_source_build lammps-2026; then timed "LAMMPS' documentation packages" setup_lammps_docs; fi
     wants_source_build lammps-2025 || return 0
     # the legacy pair style gran/hooke/stickslip as a plugin of LAMMPS 2025 (`plugin load`;
     # lammps_plugin/lammps2025.cmake; ~10 s the first time on 2 cores, relinked when liblammps
@@ -357,13 +361,22 @@ setup_liggghts_public() {
     }
 }
 
+timed() {
+    # timed NAME COMMAND...: run the command; a set-up step that took 20 s or more says how long
+    local t0=$SECONDS name=$1
+    shift
+    "$@"  # (called as a plain command, so that set -e stops the set-up at the step's first failure)
+    local dt=$((SECONDS - t0))
+    [ "$dt" -lt 20 ] || echo "setup: $name took $((dt / 60)) min $((dt % 60)) s"
+}
+
 setup() {
     setup_system
     setup_python
     setup_plugin
     setup_lammps_plugin
     setup_lammps_modern
-    setup_liggghts_public
+    timed liggghts-public setup_liggghts_public
 }
 
 case "${1:-}" in
