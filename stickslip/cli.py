@@ -176,7 +176,8 @@ def build_parser():
                                            "map of study-3d (docs/granular-3d.md)")
     shear = "needs a map that measured it"
     for name, what in (("theta_start", "angle at which a bed starts to flow, deg"),
-                       ("theta_stop", "angle at which a flowing bed stops, deg"),
+                       ("theta_stop", "angle at which a flowing bed stops on an incline held still, deg (read on an "
+                                      "incline turning down: add ~1 deg)"),
                        ("theta_heap", "angle of repose of a heap on a plate, deg"),
                        ("shear_peak", f"peak shear over normal stress of a shear cell (kind shear3d; {shear})"),
                        ("shear_steady", f"steady shear over normal stress of a shear cell (kind shear3d; {shear})"),

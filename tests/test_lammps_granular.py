@@ -21,7 +21,7 @@ import pytest
 
 from stickslip import scene as scene_mod
 from stickslip.adapters import lammps_granular
-from conftest import needs_engine, paper_case, skip_engine
+from conftest import lammps_release_launcher, lammps_releases, needs_engine, paper_case, skip_engine
 from twin_bound import assert_round_off_apart
 
 pytestmark = needs_engine("lammps_granular")
@@ -150,3 +150,59 @@ def test_unlike_types_mix_by_geometric_means(tmp_path):
     assert slips[30] == 0 and slips[31] == 1  # the first slip at step 32: 32/64 = mu_s
     fmin = (2 * mu_k - mu_s) * 1.0
     assert abs(np.linalg.norm(rows[31, 1:4]) - fmin) <= np.spacing(fmin), (rows[31], fmin)
+
+
+@pytest.mark.parametrize("reset", ["stick_slip/record", "stick_slip/total/record"])
+def test_the_record_books_the_work_each_step(tmp_path, reset):
+    """The record's dissipated work (the wall's column 14; docs/law.md "Energy": the work the
+    contact received, -F_s.V_s dt, less the increase of the spring's energy Ks |D|^2 / 2) on
+    the paper's drag, a disk on a plane wall (fix wall/gran granular), V_s held at V along
+    the wall (x velocity held, rotation locked). A sticking step grows D by V dt, so it adds
+    -F.V dt - Ks (2 D.V dt + V^2 dt^2)/2 = nu_s V^2 dt + Ks V^2 dt^2 / 2 exactly; a slip step
+    also releases spring energy, so it adds more. The record takes the difference of two
+    spring energies ~Ks |D|^2 ~ 4e-9 J/m for an increment ~3e-14 J/m: one rounding of each,
+    1e-16 x 4e-9, is ~1e-11 of the increment; 1e-8 allowed. The contract's rows read no work,
+    so a wrong sign or term in the book is seen here only. ~1 s."""
+    import numpy as np
+
+    from lammps_runs import read_dump, run_lammps
+
+    lmp = lammps_release_launcher(lammps_releases()[-1])
+    kn, nu_n, ks, x, ms, mk, dt, V = 1.2e7, 41.38, 9.6e6, 0.7999033349444176, 0.5, 0.45, 2e-6, 1e-5
+    nu_s = x * nu_n
+    model = f"hooke {kn} {nu_n} damping velocity tangential {reset} {ks} {x!r} {ms} {mk} limit_damping"
+    script = f"""units si
+dimension 2
+atom_style sphere
+atom_modify map array
+boundary f f p
+comm_modify vel yes
+region box block -0.01 0.05 -0.001 0.01 -0.001 0.001 units box
+create_box 1 box
+neighbor 0.0004 bin
+create_atoms 1 single 0.0 0.0019999733 0.0 units box
+set atom 1 diameter 0.004
+set atom 1 mass 0.032672563597333844
+pair_style granular
+pair_coeff * * {model}
+timestep {dt}
+fix floor all wall/gran granular {model} yplane 0.0 NULL contacts
+fix gravity all gravity 9.81 vector 0 -1 0
+velocity all set {V} 0.0 0.0 units box
+fix integrate all nve
+fix drag all setforce 0.0 NULL NULL
+fix twod all enforce2d
+dump d all custom 1 dump.drag id f_floor[9] f_floor[10] f_floor[11] f_floor[12] f_floor[13] f_floor[14]
+dump_modify d format float %.17g
+run 2500
+"""
+    run_lammps(tmp_path, "drag", script, exe=lmp)
+    frames = read_dump(tmp_path / "dump.drag")
+    rows = np.array([frames[k][0] for k in sorted(frames)])
+    slips, work = rows[:, 5], rows[:, 6]
+    slipped = np.diff(slips) > 0
+    gained = np.diff(work)
+    stick_gain = nu_s * V ** 2 * dt + ks * V ** 2 * dt ** 2 / 2
+    assert slipped.sum() >= 5 and (~slipped).sum() > 1000
+    assert np.allclose(gained[~slipped], stick_gain, rtol=1e-8, atol=0), gained[~slipped][:5] / stick_gain
+    assert np.all(gained[slipped] > stick_gain)

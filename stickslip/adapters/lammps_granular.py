@@ -6,7 +6,7 @@ behind its switch (RELEASES: `STICKSLIP_SOURCE_BUILDS=lammps-2025,lammps-2026`).
 
 The script is the LAMMPS adapter's (stickslip/adapters/lammps.py: grains, walls, gravity,
 integration, dumps) with the contact model in the granular syntax:
-`hooke Kn nu_n damping velocity tangential stick_slip[/total][/exact]/record Ks x nu_n mu_s mu_k
+`hooke Kn nu_n damping velocity tangential stick_slip[/total][/exact]/record Ks x mu_s mu_k
 limit_damping`. `damping velocity` makes nu_n absolute (docs/law.md step 2), and the
 sub-model's tangential damping is x times it, so x is nu_s/nu_n. The record (`/record`)
 gives the law's Fn, force and slip count: compute pair/local p13-p17 for grain pairs, the
