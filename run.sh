@@ -10,15 +10,15 @@
 # STICKSLIP_SOURCE_BUILDS (a comma-separated list; .ci/run sets it) also builds engines from
 # Debian's source packages, once, cached in build/ (a second set-up costs seconds):
 #   lammps-2025      LAMMPS 4 Feb 2025 (Debian 13's source) with the tangential sub-model
-#                    stick_slip compiled in: build/lammps_2025/build/lmp (~3 min on 2 cores)
+#                    stick_slip compiled in: build/lammps_2025/build/lmp (~8 min on 2 cores)
 #   lammps-2026      LAMMPS 4 Jul 2026 (Debian sid's source) with tools/lammps_patch.py's patch
 #                    applied, LAMMPS' own granular and pair-style test programs, and LAMMPS'
 #                    documentation packages (PyPI) for tools/lammps_docs.py:
-#                    build/lammps_2026/build/lmp (~7 min on 2 cores)
+#                    build/lammps_2026/build/lmp (~10 min on 2 cores)
 #   lammps-2026-bigbig  the same tree built again with 64-bit atom and image ids
-#                    (LAMMPS_SIZES=BIGBIG): build/lammps_2026/bigbig/lmp (~3 min)
+#                    (LAMMPS_SIZES=BIGBIG): build/lammps_2026/bigbig/lmp (~9 min)
 #   liggghts-public  LIGGGHTS-PUBLIC 3.8.0 (Debian 12's source) with tangential stick_slip
-#                    built in by `make auto`: build/liggghts_public/source/src/lmp_auto (~7 min)
+#                    built in by `make auto`: build/liggghts_public/source/src/lmp_auto (~10 min)
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -150,7 +150,7 @@ setup_lammps_release() {
     # tools/lammps_patch.py's patch (patch_lammps_tree: with its documentation, example and
     # unit-test cases), and also builds LAMMPS' own granular and pair-style tests (unittest/,
     # ENABLE_TESTING) with Debian's googletest and libyaml (LAMMPS' CMake would download
-    # googletest). Times on 2 cores, first build: 2025 2.5 min; 2026 3 min, its tests 4 min.
+    # googletest). Times on 2 cores, first build with the download: 2025 8 min; 2026 with its tests 10 min.
     local word=$1 entry suite version top src testing=0
     entry=$(tr ' ' '\n' <<< "$LAMMPS_RELEASES" | grep "^$word:") || return 1
     IFS=: read -r _ suite version top <<< "$entry"
@@ -237,7 +237,7 @@ patch_lammps_tree() {
 setup_lammps_docs() {
     # LAMMPS' documentation packages (its doc/utils/requirements.txt, from PyPI; the GitHub fork
     # of sphinx-fortran as PyPI's: tools/lammps_docs.py) and the spelling builder's enchant
-    # library and dictionary, for tools/lammps_docs.py (~1 min the first time)
+    # library and dictionary, for tools/lammps_docs.py (~40 s the first time)
     local venv=build/lammps_docs/venv want
     install_packages libenchant-2-2 hunspell-en-us clang-format
     want=$(.venv/bin/python tools/lammps_docs.py build/lammps_2026/source --requirements | sha256sum | cut -d' ' -f1)
@@ -314,8 +314,8 @@ setup_liggghts_public() {
     # `make auto` (MPI with Debian 12's OpenMPI; VTK, JPG and superquadrics off, as none is needed
     # and Debian's library has no superquadrics), with stick_slip compiled in for the 40
     # combinations LIGGGHTS compiles for tangential history (src/style_contact_model_user.whitelist).
-    # Executable: build/liggghts_public/source/src/lmp_auto; 6.6 min on 2 cores (8 min of CPU),
-    # once. A changed header is copied again and make rebuilds what includes them (1.5 min);
+    # Executable: build/liggghts_public/source/src/lmp_auto; 9.5 min on 2 cores with the
+    # download, once. A changed header is copied again and make rebuilds what includes them (1.5 min);
     # unchanged, a set-up costs nothing here. The source predates GNU make 4.3 and GCC 11: the
     # four fixes below and MPI_LIB_USR in Makefile.user let Debian 12 build it.
     wants_source_build liggghts-public || return 0
@@ -323,7 +323,7 @@ setup_liggghts_public() {
     local core=lammps_plugin/granular/stick_slip_core.h
     src=$top/source/src
     if [ ! -f "$top/source/.complete" ]; then
-        echo "setup: LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (first time: ~7 min on 2 cores)"
+        echo "setup: LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (first time: ~10 min on 2 cores)"
         fetch_debian_source bookworm liggghts "$version" "$top/download"
         rm -rf "$top/source" && mkdir -p "$top/source"
         tar -xJf "$top"/download/liggghts_*.orig.tar.xz -C "$top/source" --strip-components=1 \

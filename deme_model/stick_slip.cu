@@ -4,7 +4,10 @@
 // compiles into its force kernels (DefineContactForceModel), step by step as docs/law.md
 // states it. The only place the law lives for DEM-Engine; deme_model/README.md says how
 // to attach it (deme_model/stickslip_deme.py does it in one call) and
-// deme_model/shim/ compiles this same file on the CPU for the tests.
+// deme_model/shim/ compiles this same file on the CPU for the tests. It is the float twin
+// of the C++ engines' core (lammps_plugin/granular/stick_slip_core.h), kept apart because
+// the engine compiles this text alone, in float, into its kernels; the law's contract run
+// through the shim (tests/test_deme_shim.py) holds it to the same answers.
 //
 // Options, set by #define before this text (stickslip_deme.model_text writes them):
 //   STICKSLIP_HOOKE        1: linear normal force Fn = max(0, kn delta + nu_n v_n) (eq. 3),

@@ -88,6 +88,22 @@ def test_callgrind_total_refuses_a_file_without_summary(tmp_path):
         callgrind.total(p)
 
 
+def test_callgrind_simulated_reads_the_events_by_name_and_weighs_them(tmp_path):
+    """The summary's events are read by the names of the `events:` line (their order is
+    callgrind's, not fixed here), and the time model is instructions + 10 first-level misses
+    + 100 last-level ones + 15 mispredicted branches: a profile with one of each kind."""
+    p = tmp_path / "callgrind.out.1.1"
+    p.write_text("# callgrind format\nevents: Ir Dr Dw I1mr D1mr D1mw ILmr DLmr DLmw Bc Bcm Bi Bim\n"
+                 "fn=(1) main\n1 1000 400 200 1 2 3 4 5 6 90 7 10 8\n"
+                 "summary: 1000 400 200 1 2 3 4 5 6 90 7 10 8\n")
+    sim = callgrind.simulated(callgrind.event_totals(p))
+    assert sim == {"instructions": 1000, "l1_misses": 6, "ll_misses": 15, "mispredicts": 15,
+                   "cycles": 1000 + 10 * 6 + 100 * 15 + 15 * 15}
+    plain = tmp_path / "callgrind.out.2.1"
+    plain.write_text("events: Ir\nsummary: 170\n")  # no simulation: every miss is 0
+    assert callgrind.simulated(callgrind.event_totals(plain))["cycles"] == 170
+
+
 # The same with one cost line per instruction (--dump-instr=yes: address, line, Ir), as the
 # path analysis reads it: f's instructions at 0x10, 0x14 (ran 5 times each), 0x18 (ran 2
 # times), the call at 0x1c (its line carries g's inclusive cost, not a run count).

@@ -65,7 +65,8 @@ class Engine:
     mutants: tuple
     cmake_args: tuple = ()  # configure arguments beyond the build type
     builder: object = None  # build(src, out, quick, cmake_args) for an engine built otherwise (None: cmake -S src)
-    copies: tuple = ("lammps_plugin/granular",)  # folders copied beside `source` (the law's core)
+    # folders and files copied beside `source`: the law's core, the project's version header
+    copies: tuple = ("lammps_plugin/granular", "lammps_plugin/stickslip_version.h")
 
 
 # The law's engine-free core, included by LIGGGHTS, LAMMPS 2021's styles and the LAMMPS
@@ -438,7 +439,13 @@ def main(argv=None):
     if root.exists():
         shutil.rmtree(root)
     for folder in (eng.source, *eng.copies):
-        shutil.copytree(REPO / folder, root / folder, dirs_exist_ok=True)
+        # copied with new times (shutil.copy): a build left by an interrupted run holds a
+        # mutant's objects, newer than the repository's files, that make would keep
+        if (REPO / folder).is_file():
+            (root / folder).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(REPO / folder, root / folder)
+        else:
+            shutil.copytree(REPO / folder, root / folder, dirs_exist_ok=True, copy_function=shutil.copy)
     src = root / eng.source
     originals = {f: (root / f).read_text() for f in {m.file or eng.law_file for m in mutants}}
     env = dict(os.environ, **{eng.build_env: str(out)})

@@ -82,6 +82,39 @@ def total(profile):
     raise RuntimeError(f"{profile}: no summary line (not a callgrind profile?)")
 
 
+# A time model from callgrind's simulation of the caches and the branch predictors
+# (--cache-sim=yes --branch-sim=yes), for what an instruction count does not show: an
+# instruction costs a cycle, a miss of the first-level caches SIM_L1 more, of the last level
+# SIM_LL, a mispredicted branch SIM_MISPREDICT (round figures for a current x86 core; the
+# counts are printed beside it, for a reader to weigh otherwise).
+SIMULATION = ("--cache-sim=yes", "--branch-sim=yes")
+SIM_L1, SIM_LL, SIM_MISPREDICT = 10, 100, 15
+
+
+def event_totals(profile):
+    """{event: count} of a profile's summary line (Ir; with SIMULATION also I1mr D1mr D1mw
+    ILmr DLmr DLmw Bc Bcm Bi Bim ...), as its `events:` line names them."""
+    names = None
+    with open(profile) as f:
+        for line in f:
+            if line.startswith("events:"):
+                names = line.split()[1:]
+            elif line.startswith(("summary:", "totals:")) and names:
+                return dict(zip(names, (int(x) for x in line.split()[1:])))
+    raise RuntimeError(f"{profile}: no events and summary lines (not a callgrind profile?)")
+
+
+def simulated(events):
+    """What the simulation found, from event_totals: {instructions, l1_misses, ll_misses,
+    mispredicts, cycles} (cycles: the model above)."""
+    e = collections.Counter(events)
+    l1 = e["I1mr"] + e["D1mr"] + e["D1mw"]
+    ll = e["ILmr"] + e["DLmr"] + e["DLmw"]
+    bad = e["Bcm"] + e["Bim"]
+    return {"instructions": e["Ir"], "l1_misses": l1, "ll_misses": ll, "mispredicts": bad,
+            "cycles": e["Ir"] + SIM_L1 * l1 + SIM_LL * ll + SIM_MISPREDICT * bad}
+
+
 _NAME = re.compile(r"(c?fn)=\((\d+)\)(?: (.*))?")
 _FILE = re.compile(r"(c?fl|c?fi|fe)=\((\d+)\)(?: (.*))?")
 

@@ -252,17 +252,20 @@ def _counted(data, config, work, steps=CALLGRIND_STEPS):
     return dict(k, steps=steps)
 
 
-def counted_run(d, script, cmd, groups):
+def counted_run(d, script, cmd, groups, options=()):
     """callgrind on `cmd` in folder d, counting the steps after `script`'s (in.timed's)
     `shell ./callgrind_on.sh`: {"total": the whole time step's instructions (Verlet::run),
     and for each name of `groups` the own instructions of the functions whose names hold
-    one of its patterns}."""
+    one of its patterns}; with options=callgrind.SIMULATION also "simulated": the step's
+    callgrind.simulated figures."""
     (d / "in.timed").write_text(script)
-    profile = callgrind.count(cmd, d, env=_env(d), on_request=True)[-1]
+    profile = callgrind.count(cmd, d, env=_env(d), on_request=True, options=options)[-1]
     costs = callgrind.self_costs(profile)
     out = {name: sum(v for fn, v in costs.items() if any(p in fn for p in patterns))
            for name, patterns in groups.items()}
     out["total"] = callgrind.total(profile)
+    if options:
+        out["simulated"] = callgrind.simulated(callgrind.event_totals(profile))
     return out
 
 

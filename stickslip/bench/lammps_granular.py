@@ -38,13 +38,20 @@ measured once), ~23 300 pair contacts at their end.
    warm-up (not instrumented), in the whole time step (Verlet::run), in the contact model
    (pair granular, the wall fix, GranularModel and its sub-models) and in the tangential
    sub-model alone (with the exact timing's out-of-line function).
+3. With --simulate, what the instruction count does not show: callgrind's simulation of
+   the caches and branch predictors over the same window (callgrind.SIMULATION), each
+   configuration's first-level and last-level cache misses and mispredicted branches per
+   step against its stock's, and a time model from them (callgrind.simulated: a cycle an
+   instruction, 10 more a first-level miss, 100 a last-level one, 15 a mispredicted
+   branch), for a machine whose load leaves the time's interval too wide to tell 5 %.
 
 Cost on the 2-core machine: ~1 min of one core once for the bed; ~27 s a round (six runs:
 ~2.7 s timed, ~1.5 s of start and warm-up; 10 rounds by default), ~1.5 min of callgrind
-(two at a time): ~6 min in all (measured at load 2-4; the other processes' load slows it). (`stickslip bench` takes these rows; its `reps` has no use here: no MPI part.)
+(two at a time): ~6 min in all (measured at load 2-4; the other processes' load slows it);
+--simulate adds ~2 min. (`stickslip bench` takes these rows; its `reps` has no use here: no MPI part.)
 
     python -m stickslip.bench.lammps_granular [--release lammps-2026] [--rounds 10] [--steps 800] [--no-callgrind]
-                                              [--callgrind-steps 100]
+                                              [--callgrind-steps 100] [--simulate]
 """
 from __future__ import annotations
 
@@ -220,17 +227,19 @@ def _timed(data, config, work, steps, warm, lmp):
             "foreign": foreign, "atoms": int(base.LOOP.findall(out)[-1][3])}
 
 
-def _counted(data, config, work, steps, warm, lmp):
-    d = base._folder(work, f"callgrind-{config}")
-    k = base.counted_run(d, script(data, config, steps, warm, "shell ./callgrind_on.sh"), _command(lmp=lmp), GROUPS)
+def _counted(data, config, work, steps, warm, lmp, options=()):
+    d = base._folder(work, f"callgrind-{config}{'-simulated' if options else ''}")
+    k = base.counted_run(d, script(data, config, steps, warm, "shell ./callgrind_on.sh"), _command(lmp=lmp), GROUPS,
+                         options)
     return dict(k, steps=steps)
 
 
 def measure(rounds=ROUNDS, counts=True, callgrind_steps=CALLGRIND_STEPS, size=BED, steps=STEPS, warm=WARM,
-            cache=CACHE, log=None, release=None):
+            cache=CACHE, log=None, release=None, simulate=False):
     """Every figure of the benchmark (a dict; rows() turns it into bench rows). `log`: a
     function told of each finished round; release: the LAMMPS release to time (a word of
-    lammps_granular.RELEASES; None: the newest built)."""
+    lammps_granular.RELEASES; None: the newest built); simulate: also callgrind's cache
+    and branch simulation (the docstring's 3.)."""
     lmp = launcher(release)
     _check(lmp)
     t0 = time.monotonic()
@@ -250,6 +259,11 @@ def measure(rounds=ROUNDS, counts=True, callgrind_steps=CALLGRIND_STEPS, size=BE
             with concurrent.futures.ThreadPoolExecutor(2) as pool:
                 jobs = {c: pool.submit(_counted, data, c, work, callgrind_steps, warm, lmp) for c in order}
                 res["counts"] = {c: j.result() for c, j in jobs.items()}
+        if simulate and callgrind.available():
+            with concurrent.futures.ThreadPoolExecutor(2) as pool:
+                jobs = {c: pool.submit(_counted, data, c, work, callgrind_steps, warm, lmp, callgrind.SIMULATION)
+                        for c in order}
+                res["simulated"] = {c: j.result() for c, j in jobs.items()}
         res["callgrind_s"] = time.monotonic() - t1
     res["rounds_s"] = t1 - t0 - res["bed_s"]
     return res
@@ -297,6 +311,21 @@ def rows(res):
                                 f"tangential sub-model (target <= {TARGET[c]})",
                         "value": f"{k['total'] / s['total']:.4f} / {k['model'] / s['model']:.4f} / "
                                  f"{k['tangential'] / s['tangential']:.4f}"})
+    sim = res.get("simulated")
+    if sim:
+        keys = ("instructions", "l1_misses", "ll_misses", "mispredicts", "cycles")
+        for c in TANGENTIAL:
+            k, n = sim[c]["simulated"], sim[c]["steps"]
+            out.append({"benchmark": "lammps_granular",
+                        "case": f"{label(c)}: per step, whole step, simulated (callgrind --cache-sim --branch-sim, "
+                                f"{n} steps): instructions / L1 misses / LL misses / mispredicted branches / "
+                                f"modelled cycles", "value": " / ".join(f"{k[x] / n:.4g}" for x in keys)})
+        for c, stock in STOCK.items():
+            k, s = sim[c]["simulated"], sim[stock]["simulated"]
+            out.append({"benchmark": "lammps_granular",
+                        "case": f"{label(c)} / {label(stock)}, simulated, whole step: instructions / L1 misses / "
+                                f"LL misses / mispredicted branches / modelled cycles (target <= {TARGET[c]})",
+                        "value": " / ".join(f"{k[x] / s[x]:.4f}" if s[x] else "-" for x in keys)})
     return out
 
 
@@ -312,12 +341,15 @@ def main(argv=None):
     ap.add_argument("--no-callgrind", action="store_true")
     ap.add_argument("--callgrind-steps", type=int, default=CALLGRIND_STEPS, help="steps counted by callgrind")
     ap.add_argument("--release", choices=list(lammps_granular.RELEASES), help="the LAMMPS to time (default: the newest built)")
+    ap.add_argument("--simulate", action="store_true",
+                    help="also callgrind's cache and branch simulation and its time model (~2 min)")
     a = ap.parse_args(argv)
     if a.rounds < 1 or a.steps < 1 or a.callgrind_steps < 1:
         ap.error("--rounds, --steps and --callgrind-steps must be >= 1")
     try:
         res = measure(a.rounds, not a.no_callgrind, a.callgrind_steps, steps=a.steps,
-                      log=lambda text: print(text, file=sys.stderr, flush=True), release=a.release)
+                      log=lambda text: print(text, file=sys.stderr, flush=True), release=a.release,
+                      simulate=a.simulate)
     except RuntimeError as e:
         print(f"lammps_granular_bench: {e}", file=sys.stderr)
         return 1
