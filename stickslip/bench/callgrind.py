@@ -75,11 +75,7 @@ def count(cmd, cwd, function=VERLET_RUN, env=None, timeout=7200, on_request=Fals
 
 def total(profile):
     """All instructions counted in a profile (its `summary:` line)."""
-    with open(profile) as f:
-        for line in f:
-            if line.startswith(("summary:", "totals:")):
-                return int(line.split()[1])
-    raise RuntimeError(f"{profile}: no summary line (not a callgrind profile?)")
+    return event_totals(profile)["Ir"]
 
 
 # A time model from callgrind's simulation of the caches and the branch predictors
@@ -101,7 +97,7 @@ def event_totals(profile):
                 names = line.split()[1:]
             elif line.startswith(("summary:", "totals:")) and names:
                 return dict(zip(names, (int(x) for x in line.split()[1:])))
-    raise RuntimeError(f"{profile}: no events and summary lines (not a callgrind profile?)")
+    raise RuntimeError(f"{profile}: no summary line under an events line (not a callgrind profile?)")
 
 
 def simulated(events):

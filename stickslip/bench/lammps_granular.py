@@ -48,7 +48,7 @@ measured once), ~23 300 pair contacts at their end.
 Cost on the 2-core machine: ~1 min of one core once for the bed; ~27 s a round (six runs:
 ~2.7 s timed, ~1.5 s of start and warm-up; 10 rounds by default), ~1.5 min of callgrind
 (two at a time): ~6 min in all (measured at load 2-4; the other processes' load slows it);
---simulate adds ~2 min. (`stickslip bench` takes these rows; its `reps` has no use here: no MPI part.)
+--simulate makes callgrind's pass ~2 min longer. (`stickslip bench` takes these rows; its `reps` has no use here: no MPI part.)
 
     python -m stickslip.bench.lammps_granular [--release lammps-2026] [--rounds 10] [--steps 800] [--no-callgrind]
                                               [--callgrind-steps 100] [--simulate]
@@ -228,7 +228,7 @@ def _timed(data, config, work, steps, warm, lmp):
 
 
 def _counted(data, config, work, steps, warm, lmp, options=()):
-    d = base._folder(work, f"callgrind-{config}{'-simulated' if options else ''}")
+    d = base._folder(work, f"callgrind-{config}")
     k = base.counted_run(d, script(data, config, steps, warm, "shell ./callgrind_on.sh"), _command(lmp=lmp), GROUPS,
                          options)
     return dict(k, steps=steps)
@@ -255,15 +255,12 @@ def measure(rounds=ROUNDS, counts=True, callgrind_steps=CALLGRIND_STEPS, size=BE
                 log(f"round {r + 1}/{rounds}: "
                     + ", ".join(f"{c} {x['cpu']:.3f} s" for c, x in res["rounds"][-1].items()))
         t1 = time.monotonic()
-        if counts and callgrind.available():
+        if (counts or simulate) and callgrind.available():
+            # one callgrind pass: the simulation leaves the instruction counts as they are
+            options = callgrind.SIMULATION if simulate else ()
             with concurrent.futures.ThreadPoolExecutor(2) as pool:
-                jobs = {c: pool.submit(_counted, data, c, work, callgrind_steps, warm, lmp) for c in order}
+                jobs = {c: pool.submit(_counted, data, c, work, callgrind_steps, warm, lmp, options) for c in order}
                 res["counts"] = {c: j.result() for c, j in jobs.items()}
-        if simulate and callgrind.available():
-            with concurrent.futures.ThreadPoolExecutor(2) as pool:
-                jobs = {c: pool.submit(_counted, data, c, work, callgrind_steps, warm, lmp, callgrind.SIMULATION)
-                        for c in order}
-                res["simulated"] = {c: j.result() for c, j in jobs.items()}
         res["callgrind_s"] = time.monotonic() - t1
     res["rounds_s"] = t1 - t0 - res["bed_s"]
     return res
@@ -311,7 +308,7 @@ def rows(res):
                                 f"tangential sub-model (target <= {TARGET[c]})",
                         "value": f"{k['total'] / s['total']:.4f} / {k['model'] / s['model']:.4f} / "
                                  f"{k['tangential'] / s['tangential']:.4f}"})
-    sim = res.get("simulated")
+    sim = counts if counts and "simulated" in next(iter(counts.values())) else None
     if sim:
         keys = ("instructions", "l1_misses", "ll_misses", "mispredicts", "cycles")
         for c in TANGENTIAL:
