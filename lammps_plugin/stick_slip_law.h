@@ -258,10 +258,20 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
   const double sum = fs[0] * fs[0] + fs[1] * fs[1] + fs[2] * fs[2];
   bool slipped = LAMMPS_NS::StickSlipCore::slips(sum, limit * limit);
   if (Mode::exact(s)) {
-    // E0-E7 (stick_slip_core.h); an evaluation without update (set-up) is a step of length 0
-    double stick;
-    slipped = LAMMPS_NS::StickSlipCore::exact_step(slipped, fs, D, vtr, kt, nu_s, update ? dt : 0.0, limit,
-                                                   c.kin * fnabs, c.ratio, s.reset_total, stick);
+    // E0-E7 (stick_slip_core.h's exact_step, called in its parts: a sticking step then
+    // evaluates none of slip_step's arguments, whose loads and products would otherwise take
+    // registers from the contact loop); an evaluation without update (set-up) is a step of
+    // length 0
+    const double h = update ? dt : 0.0;
+    double F0[3];
+    const double start2 = LAMMPS_NS::StickSlipCore::start_force(fs, vtr, kt * h, F0);
+    const bool start_slips = LAMMPS_NS::StickSlipCore::slips(start2, limit * limit);
+    if (STICK_SLIP_UNLIKELY(LAMMPS_NS::StickSlipCore::step_slips(slipped, start_slips))) {
+      double stick;
+      LAMMPS_NS::StickSlipCore::slip_step(start_slips, F0, start2, fs, D, vtr, kt, nu_s, h, limit, c.kin * fnabs,
+                                          c.ratio, s.reset_total, stick);
+      slipped = true;
+    }
   } else if (slipped) {
     // (stock's |D| after the increment, tested only here, at a slip)
     if (Mode::project(s) && incremented[0] * incremented[0] + incremented[1] * incremented[1] +

@@ -275,3 +275,17 @@ def test_the_analysis_builds_find_their_places_in_the_law():
     control = lv.headers("control")[lv.LAW.name]
     assert lv.CONTROL_CLASS in control and "StickSlipCore::" not in control
     assert len(lammps_paths.marker_lines()) == sum(len(m) for m in lammps_paths.MARKERS.values())
+
+
+def test_the_lammps_path_markers_name_the_profile_s_lines():
+    """A marker names the group that runs its line, whatever folder its file is in (the
+    profile names a file by its path; the core lies in granular/): one made-up profile line
+    per marker, each alone in its group, comes back named."""
+    from stickslip.bench import lammps_paths
+
+    markers = lammps_paths.marker_lines()
+    runs = {k: ("PairGranHookeStickSlip::contacts", f"/src/lammps_plugin/{'granular/' if 'core' in f else ''}{f}",
+                line, 10 + k)
+            for k, (f, line) in enumerate(markers)}
+    named = {name for _, _, name in lammps_paths.our_groups(runs, markers)}
+    assert named == {f"pair: {path}" for path in markers.values()}

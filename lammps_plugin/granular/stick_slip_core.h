@@ -32,9 +32,11 @@
 #if defined(__GNUC__)
 #define STICK_SLIP_ALWAYS_INLINE inline __attribute__((always_inline))
 #define STICK_SLIP_NOINLINE __attribute__((noinline))
+#define STICK_SLIP_UNLIKELY(x) __builtin_expect(!!(x), 0)
 #else
 #define STICK_SLIP_ALWAYS_INLINE inline
 #define STICK_SLIP_NOINLINE
+#define STICK_SLIP_UNLIKELY(x) (x)
 #endif
 
 namespace LAMMPS_NS {
@@ -85,25 +87,49 @@ class StickSlipCore {
      spring after its increment, plus the dashpot's force -nu_s V_s); out, the force applied.
      end_slips: the host's slip test of that trial force. T = mu_s Fn, fmin = Fmin, ratio =
      Fmin/T. Returns whether the step slips; then D (out) is the spring at its end, else
-     the host's spring and F stand. stick: the share of the step spent sticking. */
+     the host's spring and F stand. stick: the share of the step spent sticking.
+     It is E0 (start_force, step_slips) and, in a step that slips, slip_step: a host may call
+     the three itself, so that a sticking step evaluates none of slip_step's arguments. */
   static STICK_SLIP_ALWAYS_INLINE bool exact_step(bool end_slips, double *F, double *D,
                                                   const double *vs, double ks, double nu_s,
                                                   double dt, double T, double fmin, double ratio,
                                                   bool total, double &stick)
   {
-    // E0: |F| moves on a line in the step and is convex, so the step has no slip iff the trial
-    // force is below T at both ends; at the start the spring lacks its increment Ks V_s dt
-    const double ksdt = ks * dt;
-    const double F0[3] = {F[0] + ksdt * vs[0], F[1] + ksdt * vs[1], F[2] + ksdt * vs[2]};
-    const double start2 = dot(F0, F0);
+    double F0[3];
+    const double start2 = start_force(F, vs, ks * dt, F0);
     const bool start_slips = slips(start2, T * T);
     stick = 1.0;
-    if (!(end_slips || start_slips)) return false;
+    // (most steps stick: the slipping code is laid out of the sticking path)
+    if (STICK_SLIP_UNLIKELY(step_slips(end_slips, start_slips))) {
+      slip_step(start_slips, F0, start2, F, D, vs, ks, nu_s, dt, T, fmin, ratio, total, stick);
+      return true;
+    }
+    return false;
+  }
+
+  /* E0: F: the trial force at the step's end; F0 (out): at its start, where the spring lacks
+     its increment Ks V_s dt (ksdt = Ks dt). Returns |F0|^2. */
+  static STICK_SLIP_ALWAYS_INLINE double start_force(const double *F, const double *vs, double ksdt,
+                                                     double *F0)
+  {
+    for (int i = 0; i < 3; i++) F0[i] = F[i] + ksdt * vs[i];
+    return dot(F0, F0);
+  }
+
+  // E0: |F| moves on a line in the step and is convex, so the step has no slip iff the trial
+  // force is below T at both ends (end_slips, start_slips: slips() of each)
+  static bool step_slips(bool end_slips, bool start_slips) { return end_slips || start_slips; }
+
+  /* E1-E7 for a step that E0 found slipping: start_slips, F0 and start2 = |F0|^2 are E0's
+     (start_force), the rest as exact_step's. */
+  static STICK_SLIP_ALWAYS_INLINE void slip_step(bool start_slips, const double *F0, double start2,
+                                                 double *F, double *D, const double *vs, double ks,
+                                                 double nu_s, double dt, double T, double fmin,
+                                                 double ratio, bool total, double &stick)
+  {
     stick = 0.0;
     const double vs2 = dot(vs, vs), damp2 = nu_s * nu_s;
-    // (|Fmin t0 + nu_s |V_s| u| <= Fmin + nu_s |V_s|: E4 needs nu_s |V_s| >= T - Fmin first)
-    if (start_slips && T > 0.0 && !total && damp2 * vs2 >= (T - fmin) * (T - fmin) &&
-        damp2 * vs2 > 0.0 &&
+    if (start_slips && T > 0.0 && !total && damp2 * vs2 > 0.0 &&
         (fmin * fmin + damp2 * vs2 - T * T) * std::sqrt(start2) - 2.0 * fmin * nu_s * dot(F0, vs) >=
             0.0) {
       // E4 at the step's start, the common slipping case of a flowing bed: the force is at or
@@ -116,21 +142,32 @@ class StickSlipCore {
         F[i] = -a * vs[i];
         D[i] = aks * vs[i];
       }
-      return true;
+      return;
     }
-    // the general case, on copies (an address taken here would keep the common path's
-    // vectors in memory)
+    // the general case, out of line on copies (an address taken here would keep the common
+    // path's vectors in memory, and values live across a call would leave the registers)
     const double f0[3] = {F0[0], F0[1], F0[2]}, v[3] = {vs[0], vs[1], vs[2]};
-    double applied[3], trial[3];
-    // E6 when nothing is added at a reset
-    exact_slips(f0, v, T, fmin, ratio, ks, nu_s, dt, total, ratio == 1.0 && (total || nu_s == 0.0),
-                applied, trial, stick);
-    // the spring at the end holds the trial force less the dashpot (eq. 5)
+    double applied[3], spring[3];
+    stick = exact_general(f0, v, T, fmin, ratio, ks, nu_s, dt, total, applied, spring);
     for (int i = 0; i < 3; i++) {
       F[i] = applied[i];
-      D[i] = -(trial[i] + nu_s * vs[i]) / ks;
+      D[i] = spring[i];
     }
-    return true;
+  }
+
+  /* exact_slips for a step from its start (E6 when nothing is added at a reset): the force
+     applied at its end, the spring there, which holds the trial force less the dashpot
+     (eq. 5); returns the share of the step spent sticking. */
+  static STICK_SLIP_NOINLINE double exact_general(const double *F0, const double *vs, double T,
+                                                  double fmin, double ratio, double ks, double nu_s,
+                                                  double dt, bool total, double *applied,
+                                                  double *spring)
+  {
+    double trial[3], stick;
+    exact_slips(F0, vs, T, fmin, ratio, ks, nu_s, dt, total, ratio == 1.0 && (total || nu_s == 0.0),
+                applied, trial, stick);
+    for (int i = 0; i < 3; i++) spring[i] = -(trial[i] + nu_s * vs[i]) / ks;
+    return stick;
   }
 
   /* E6: mu_k = mu_s, the force stays on |F| = T and turns towards u. With phi the angle

@@ -57,10 +57,10 @@ MARKERS = {
         "const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;": "step: slip (reset to Fmin)",
     },
     "granular/stick_slip_core.h": {
-        "const double start2 = dot(F0, F0);": "exact: every evaluation (E0)",
+        "for (int i = 0; i < 3; i++) F0[i] = F[i] + ksdt * vs[i];": "exact: every evaluation (E0)",
         "if (start_slips && T > 0.0 && !total": "exact: a slip in the step (E4 tested)",
         "F[i] = -a * vs[i];": "exact: E4 at the step's start (slides)",
-        "exact_slips(f0, v, T, fmin, ratio, ks, nu_s, dt, total,": "exact: general case",
+        "stick = exact_general(f0, v, T, fmin, ratio, ks, nu_s, dt, total, applied, spring);": "exact: general case",
         "const double speed = std::sqrt(dot(vs, vs));": "exact_slips: every call",
         "applied[k] = 0.0;": "E1 (Fn = 0)",
         "const double f = dot(F, u), F2 = dot(F, F);": "E2 (next slip sought)",
@@ -119,7 +119,7 @@ def marker_lines():
             lines = [k + 1 for k, text in enumerate(source) if statement in text]
             if len(lines) != 1:
                 raise RuntimeError(f"marker of '{path}' found {len(lines)} times in lammps_plugin/{name}: {statement}")
-            out[(name, lines[0])] = path
+            out[(Path(name).name, lines[0])] = path  # (the profile names a file without its folder)
     return out
 
 
