@@ -2,6 +2,7 @@
 """The benchmark's measuring tools (issue 32): the interval of a ratio measured in
 interleaved rounds, and the reading of callgrind's profiles. Cost: ~0.3 s in all."""
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -284,8 +285,8 @@ def test_the_lammps_path_markers_name_the_profile_s_lines():
     from stickslip.bench import lammps_paths
 
     markers = lammps_paths.marker_lines()
-    runs = {k: ("PairGranHookeStickSlip::contacts", f"/src/lammps_plugin/{'granular/' if 'core' in f else ''}{f}",
-                line, 10 + k)
+    where = {Path(name).name: name for name in lammps_paths.MARKERS}  # file -> its path in lammps_plugin/
+    runs = {k: ("PairGranHookeStickSlip::contacts", f"/src/lammps_plugin/{where[f]}", line, 10 + k)
             for k, (f, line) in enumerate(markers)}
     named = {name for _, _, name in lammps_paths.our_groups(runs, markers)}
     assert named == {f"pair: {path}" for path in markers.values()}
