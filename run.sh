@@ -110,6 +110,46 @@ setup_lammps_plugin() {
     cmake --build build/lammps_plugin -j 2 >/dev/null
 }
 
+# The compiled YADE law's headers: YADE's own, from the oldest YADE source Debian serves (Debian
+# 12's 2023.02a source does not download): suite, source version.
+YADE_HEADERS_SOURCE="trixie:2025.2.0-1"
+
+setup_yade_law() {
+    # The compiled YADE law (yade_law/compiled/): a YADE plugin built against Debian's YADE
+    # without rebuilding YADE. YADE's 2025.2.0 source (14 MB, downloaded once; only the headers
+    # of core/, lib/ and pkg/ are kept, build/yade_source/), the plugin compiled with the
+    # definitions read from the installed YADE (yade_flags.py), a private YADE prefix
+    # (build/yade_law/prefix) and the launcher build/yade_law/yade-stickslip, which checks the
+    # plugin against the installed YADE (layout_check.py) and starts YADE with it. ~4 min on 2
+    # cores the first time; cmake rebuilds only what changed. Also a second plugin built for a
+    # YADE without MPI (build/yade_law_wrong), which the layout check must refuse
+    # (tests/test_yade_compiled.py), ~4 min once.
+    command -v yade >/dev/null 2>&1 || return 0
+    install_packages libeigen3-dev libboost-python-dev libboost-serialization-dev libboost-log-dev \
+        libboost-thread-dev libcgal-dev python3-dev || return 0
+    local top=build/yade_source suite version
+    IFS=: read -r suite version <<< "$YADE_HEADERS_SOURCE"
+    if [ ! -f "$top/src/.complete" ]; then
+        echo "setup: YADE ${version%%-*}'s headers from Debian's source ($suite), for the compiled YADE law"
+        fetch_debian_source "$suite" yade "$version" "$top/download"
+        rm -rf "$top/src" && mkdir -p "$top/src"
+        tar -xf "$top"/download/yade_*.orig.tar.* -C "$top/src" --strip-components=1 --wildcards \
+            '*/RELEASE' '*/core/*.hpp' '*/lib/*.hpp' '*/lib/*.h' '*/lib/*.ipp' '*/pkg/*.hpp'
+        echo "$version" > "$top/src/.complete"
+    fi
+    local build
+    for build in yade_law yade_law_wrong; do
+        local extra=()
+        [ "$build" = yade_law_wrong ] && extra=(-D "YADE_FLAGS_ARGS=--without;MPI")
+        [ -f "build/$build/CMakeCache.txt" ] || \
+            cmake -S yade_law/compiled -B "build/$build" -DCMAKE_BUILD_TYPE=Release \
+                  -DYADE_SOURCE="$PWD/$top/src" "${extra[@]}" >/dev/null
+        cmake --build "build/$build" -j "$(nproc)" >/dev/null
+    done
+    # the verdict now (it is kept beside the plugin): one line if the plugin is refused
+    python3 yade_law/compiled/layout_check.py build/yade_law/prefix || true
+}
+
 wants_source_build() {
     case ",${STICKSLIP_SOURCE_BUILDS:-}," in *",$1,"*) return 0 ;; *) return 1 ;; esac
 }
@@ -137,15 +177,16 @@ fetch_debian_source() {
 
 # The modern LAMMPS releases Debian carries, each built from its source package behind the
 # switch (its word), the same minimal build: core + GRANULAR + PLUGIN, MPI (Debian 12's
-# OpenMPI), shared library, with lammps_plugin/granular/ copied into src/GRANULAR/ as a user
-# would. word: Debian suite, source version, folder under build/.
+# OpenMPI), shared library, with lammps_plugin/granular/ and the law's core copied into
+# src/GRANULAR/ as a user would. word: Debian suite, source version, folder under build/.
 LAMMPS_RELEASES="lammps-2025:trixie:20250204+dfsg.1-2:lammps_2025 lammps-2026:sid:20260704+dfsg-2:lammps_2026"
 
 setup_lammps_release() {
     # setup_lammps_release WORD: the release's source (downloaded once: 132 MB for 2025, 214 MB
     # for 2026), extracted without what no build here reads; then cmake. 4 Feb 2025 takes
-    # lammps_plugin/granular/ copied into src/GRANULAR/ as a user would: sources whose copy
-    # changed are copied again and rebuilt (cmake reconfigures: the sub-model registry is
+    # lammps_plugin/granular/ and law_core/stick_slip_core.h copied into src/GRANULAR/ as a
+    # user would: sources whose copy changed are copied again and rebuilt (cmake
+    # reconfigures: the sub-model registry is
     # generated at configure time). 4 Jul 2026 takes the sub-model as a pull request would, by
     # tools/lammps_patch.py's patch (patch_lammps_tree: with its documentation, example and
     # unit-test cases), and also builds LAMMPS' own granular and pair-style tests (unittest/,
@@ -178,7 +219,7 @@ setup_lammps_release() {
     fi
     local changed=0 f
     if [ "$testing" = 0 ]; then
-        for f in lammps_plugin/granular/*; do
+        for f in lammps_plugin/granular/* law_core/stick_slip_core.h; do
             cmp -s "$f" "$src/src/GRANULAR/${f##*/}" || { cp "$f" "$src/src/GRANULAR/"; changed=1; }
         done
     else
@@ -310,7 +351,7 @@ wheel_check() {
 setup_liggghts_public() {
     # LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (6.5 MB, downloaded once), built as its users
     # build it: liggghts_plugin/tangential_model_stick_slip.h and the law's core
-    # (lammps_plugin/granular/stick_slip_core.h) copied into src/ and LIGGGHTS' own
+    # (law_core/stick_slip_core.h) copied into src/ and LIGGGHTS' own
     # `make auto` (MPI with Debian 12's OpenMPI; VTK, JPG and superquadrics off, as none is needed
     # and Debian's library has no superquadrics), with stick_slip compiled in for the 40
     # combinations LIGGGHTS compiles for tangential history (src/style_contact_model_user.whitelist).
@@ -320,7 +361,7 @@ setup_liggghts_public() {
     # four fixes below and MPI_LIB_USR in Makefile.user let Debian 12 build it.
     wants_source_build liggghts-public || return 0
     local top=build/liggghts_public version=3.8.0+repack1-9 src header=tangential_model_stick_slip.h
-    local core=lammps_plugin/granular/stick_slip_core.h
+    local core=law_core/stick_slip_core.h
     src=$top/source/src
     if [ ! -f "$top/source/.complete" ]; then
         echo "setup: LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (first time: ~10 min on 2 cores)"
@@ -375,6 +416,7 @@ setup() {
     setup_python
     setup_plugin
     setup_lammps_plugin
+    timed "the compiled YADE law" setup_yade_law
     setup_lammps_modern
     timed liggghts-public setup_liggghts_public
 }

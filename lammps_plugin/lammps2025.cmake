@@ -61,7 +61,7 @@ endif()
 
 add_library(stickslip_lammps2025 MODULE pair_gran_hooke_stickslip.cpp stickslip_lammpsplugin.cpp)
 set_target_properties(stickslip_lammps2025 PROPERTIES CXX_STANDARD 17 CXX_STANDARD_REQUIRED ON CXX_EXTENSIONS OFF)
-target_include_directories(stickslip_lammps2025 PRIVATE ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR}/granular
+target_include_directories(stickslip_lammps2025 PRIVATE ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR}/granular ${CMAKE_CURRENT_SOURCE_DIR}/../law_core
                            ${LAMMPS_2025_SRC} ${LAMMPS_2025_SRC}/GRANULAR)
 target_compile_definitions(stickslip_lammps2025 PRIVATE STICKSLIP_LAMMPS_VERSION=${lammps_version} ${sizes_define}
                            OMPI_SKIP_MPICXX MPICH_SKIP_MPICXX)

@@ -430,8 +430,8 @@ double PairGranHookeStickSlip::single(int i, int j, int itype, int jtype, double
   }
   const double fnabs = std::fabs(ccel * r);
   if (fs2 >= (c.mu_s * fnabs) * (c.mu_s * fnabs)) {
-    const double ratio = fs2 > 0.0 ? c.kin * fnabs / sqrt(fs2) : 0.0;
-    for (int k = 0; k < 3; k++) fs[k] *= ratio;
+    const double ratio = stickslip::StickSlipCore::drop_to(fs, c.kin * fnabs, sqrt(fs2),
+                                                           stickslip::StickSlipCore::stock_ratio);
     fs2 *= ratio * ratio;
   }
   for (int k = 0; k < 3; k++) svector[k] = fs[k];

@@ -4,7 +4,7 @@
    The styles' part of the law (the pair style and the walls call it): the settings, the
    spring's turn and the trial force as stock gran/hooke/history computes them, and stock's
    rescale for reset total; the rest of the law (the slip test, eq. 8's reset to Fmin, exact
-   timing E0-E7, the energy) is the engine-free core, granular/stick_slip_core.h, that the
+   timing E0-E7, the energy) is the engine-free core, law_core/stick_slip_core.h, that the
    granular sub-model and the LIGGGHTS plugin share.
 
    With the default settings (reset total, slip_timing step, history_rotation project,
@@ -144,7 +144,7 @@ inline Coeffs make_coeffs(double kt, double mu_s, double mu_k)
   Coeffs c;
   c.kt = kt;
   c.mu_s = mu_s;
-  c.kin = LAMMPS_NS::StickSlipCore::kinetic(mu_s, mu_k);
+  c.kin = stickslip::StickSlipCore::kinetic(mu_s, mu_k);
   c.ratio = mu_s > 0.0 ? c.kin / mu_s : 1.0;
   return c;
 }
@@ -256,7 +256,7 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
   const double fnabs = std::fabs(ccel_r);
   const double limit = c.mu_s * fnabs;
   const double sum = fs[0] * fs[0] + fs[1] * fs[1] + fs[2] * fs[2];
-  bool slipped = LAMMPS_NS::StickSlipCore::slips(sum, limit * limit);
+  bool slipped = stickslip::StickSlipCore::slips(sum, limit * limit);
   if (Mode::exact(s)) {
     // E0-E7 (stick_slip_core.h's exact_step, called in its parts: a sticking step then
     // evaluates none of slip_step's arguments, whose loads and products would otherwise take
@@ -264,11 +264,11 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
     // length 0
     const double h = update ? dt : 0.0;
     double F0[3];
-    const double start2 = LAMMPS_NS::StickSlipCore::start_force(fs, vtr, kt * h, F0);
-    const bool start_slips = LAMMPS_NS::StickSlipCore::slips(start2, limit * limit);
-    if (STICK_SLIP_UNLIKELY(LAMMPS_NS::StickSlipCore::step_slips(slipped, start_slips))) {
+    const double start2 = stickslip::StickSlipCore::start_force(fs, vtr, kt * h, F0);
+    const bool start_slips = stickslip::StickSlipCore::slips(start2, limit * limit);
+    if (STICK_SLIP_UNLIKELY(stickslip::StickSlipCore::step_slips(slipped, start_slips))) {
       double stick;
-      LAMMPS_NS::StickSlipCore::slip_step(start_slips, F0, start2, fs, D, vtr, kt, nu_s, h, limit, c.kin * fnabs,
+      stickslip::StickSlipCore::slip_step(start_slips, F0, start2, fs, D, vtr, kt, nu_s, h, limit, c.kin * fnabs,
                                           c.ratio, s.reset_total, stick);
       slipped = true;
     }
@@ -282,7 +282,8 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
       fs[0] = fs[1] = fs[2] = 0.0;
     } else {
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) |Fn| along the trial force
-      const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;
+      const double ratio = stickslip::StickSlipCore::drop_to(fs, c.kin * fnabs, std::sqrt(sum),
+                                                             stickslip::StickSlipCore::stock_ratio);
       if (s.reset_total) {
         // reset total: spring + dashpot = Fmin in stock's rescale of the shear, so that with
         // mu_k = mu_s the renamed styles are stock bit for bit
@@ -291,11 +292,8 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
           D[k] = ratio * (D[k] + dv) - dv;
         }
       }
-      fs[0] *= ratio;
-      fs[1] *= ratio;
-      fs[2] *= ratio;
       // eq. 8, reset spring (the paper): Ks |D| = Fmin
-      if (!s.reset_total) LAMMPS_NS::StickSlipCore::reset(fs, nullptr, kt, false, D);
+      if (!s.reset_total) stickslip::StickSlipCore::reset(fs, nullptr, kt, false, D);
     }
   }
 
@@ -305,7 +303,7 @@ __attribute__((always_inline)) inline void tangential_force(const Settings &s, c
       // the increase of the spring energy Ks |D|^2/2
       const double before = hist[0] * hist[0] + hist[1] * hist[1] + hist[2] * hist[2];
       const double after = D[0] * D[0] + D[1] * D[1] + D[2] * D[2];
-      hist[HIST_WORK] += LAMMPS_NS::StickSlipCore::dissipated(fs, vtr, dt, kt, before, after);
+      hist[HIST_WORK] += stickslip::StickSlipCore::dissipated(fs, vtr, dt, kt, before, after);
       if (slipped) hist[HIST_NSLIP] += 1.0;
     }
     hist[HIST_FN] = ccel_r;

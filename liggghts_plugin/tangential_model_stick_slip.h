@@ -26,7 +26,7 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 #include "neighbor.h"
 #include "atom.h"
 #include "fix_property_atom.h"
-// the law's engine-free core, shared with LAMMPS (lammps_plugin/granular/)
+// the law's engine-free core, shared with LAMMPS and YADE (law_core/)
 #include "stick_slip_core.h"
 #include <algorithm>
 #include <cmath>
@@ -42,6 +42,8 @@ TANGENTIAL_MODEL(TANGENTIAL_STICK_SLIP,stick_slip,23)
 
 namespace LIGGGHTS {
 namespace ContactModels {
+
+using stickslip::StickSlipCore;
 
 namespace StickSlip {
   static const char * const KINETIC = "coefficientKineticFriction";
@@ -290,8 +292,7 @@ public:
     } else if (slip) {
       // kinematic phase: the force drops to Fmin = (2 mu_k - mu_s) Fn along the trial force
       const double fmin = StickSlipCore::kinetic(ms, mu_k[sidata.itype][sidata.jtype]) * fn;
-      const double scale = mag2 > 0.0 ? fmin / std::sqrt(mag2) : 0.0;
-      FOR_XYZ(k) F[k] *= scale;
+      StickSlipCore::drop_to(F, fmin, std::sqrt(mag2), StickSlipCore::stock_ratio);
       // eq. 8: reset the spring so that it carries Fmin (or spring + dashpot do)
       const double fdamp[3] = { -gammat * vs[0], -gammat * vs[1], -gammat * vs[2] };
       StickSlipCore::reset(F, fdamp, kt, reset_total, D);

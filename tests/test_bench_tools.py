@@ -280,8 +280,9 @@ def test_the_analysis_builds_find_their_places_in_the_law():
 
 def test_the_lammps_path_markers_name_the_profile_s_lines():
     """A marker names the group that runs its line, whatever folder its file is in (the
-    profile names a file by its path; the core lies in granular/): one made-up profile line
-    per marker, each alone in its group, comes back named."""
+    profile names a file by its path; the core lies in law_core/): one made-up profile line
+    per marker, each alone in its group, comes back named (the core's path from lammps_plugin/
+    is ../law_core/)."""
     from stickslip.bench import lammps_paths
 
     markers = lammps_paths.marker_lines()

@@ -33,7 +33,7 @@ from stickslip.adapters.lammps_family import serial_mpi_env
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "liggghts_plugin" / "examples"
 # the law: the two files copied (the LIGGGHTS model and the law's engine-free core)
-HEADERS = (ROOT / "liggghts_plugin" / "tangential_model_stick_slip.h", ROOT / "lammps_plugin" / "granular" / "stick_slip_core.h")
+HEADERS = (ROOT / "liggghts_plugin" / "tangential_model_stick_slip.h", ROOT / "law_core" / "stick_slip_core.h")
 # (STICKSLIP_LIGGGHTS_PUBLIC: another build of it)
 LMP_AUTO = Path(os.environ.get("STICKSLIP_LIGGGHTS_PUBLIC")
                 or ROOT / "build" / "liggghts_public" / "source" / "src" / "lmp_auto")

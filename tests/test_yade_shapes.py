@@ -82,8 +82,9 @@ if mode == "native":
                  InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Facet_Sphere_ScGeom()],
                                  [Ip2_ViscElMat_ViscElMat_ViscElPhys()], [Law2_ScGeom_ViscElPhys_Basic()]),
                  *extra, NewtonIntegrator()]
-else:
-    O.engines = stickslip_engines(ks=KS, nu_s=0.0, mu_s=MU, mu_k=MU, extra=extra, check=True)
+else:  # the Python law ("law") or the compiled one ("cpp", YADE started through its launcher)
+    O.engines = stickslip_engines(ks=KS, nu_s=0.0, mu_s=MU, mu_k=MU, extra=extra, check=mode == "law",
+                                  backend="cpp" if mode == "cpp" else "python")
 O.dt = {dt!r}
 log = []
 for steps, vel in plan:
@@ -124,21 +125,22 @@ print("RESULT " + json.dumps(out))
 """
 
 
-def batch(name, code, cases, result_name):
+def batch(name, code, cases, result_name, launcher="yade"):
     """{case: result} of `code` run for every case of `cases` (dicts of names) in one YADE
-    process, once per test session (conftest.shared_result)."""
+    process (started by `launcher`: the compiled law's for its cases), once per test session
+    (conftest.shared_result)."""
     def make():
         folder = Path(tempfile.mkdtemp(prefix=name, dir=conftest.SHARED))
         (folder / "case.py").write_text(code)
         (folder / "batch.py").write_text(BATCH)
-        got = yade(folder, folder / "batch.py", json.dumps(cases), folder / "case.py", result_name)
+        got = yade(folder, folder / "batch.py", json.dumps(cases), folder / "case.py", result_name, launcher=launcher)
         return [json.dumps(c, sort_keys=True) for c in cases], got
-    keys, got = conftest.shared_result(name, code + json.dumps(cases) + result_name, make)
+    keys, got = conftest.shared_result(name, code + json.dumps(cases) + result_name + str(launcher), make)
     return dict(zip(keys, got))
 
 
-def yade(tmp_path, script, *args, timeout=600):
-    p = subprocess.run(["yade", "-n", "-x", str(script), *map(str, args)], capture_output=True, text=True,
+def yade(tmp_path, script, *args, timeout=600, launcher="yade"):
+    p = subprocess.run([str(launcher), "-n", "-x", str(script), *map(str, args)], capture_output=True, text=True,
                        timeout=timeout, cwd=tmp_path, env={"PATH": "/usr/bin:/bin", "HOME": str(tmp_path)})
     got = [x for x in p.stdout.splitlines() if x.startswith("RESULT ")]
     assert p.returncode == 0 and got, p.stdout[-3000:] + p.stderr[-3000:]
@@ -157,11 +159,22 @@ def longest_stick(flags):
 SCENES = ["spheres", "spheres_rolling", "facet", "facet_translating", "facet_rotating", "periodic", "clump"]
 
 
+def scene_runs(modes, launcher="yade"):
+    """{(scene, mode): log} of every scene in each mode (native, law, cpp), one YADE process."""
+    runs = batch("cundall-strack", SCENE.format(law=str(LAW), kn=KN, ks=KS, mu=MU, r=R, delta=DELTA, dt=DT),
+                 [{"scene": s, "mode": m} for s in SCENES for m in modes], "log", launcher=launcher)
+    return {(s, m): runs[json.dumps({"mode": m, "scene": s}, sort_keys=True)] for s in SCENES for m in modes}
+
+
 @pytest.mark.parametrize("scene", SCENES)
 def test_reproduces_native_cundall_strack(scene):
-    runs = batch("cundall-strack", SCENE.format(law=str(LAW), kn=KN, ks=KS, mu=MU, r=R, delta=DELTA, dt=DT),
-                 [{"scene": s, "mode": m} for s in SCENES for m in ("native", "law")], "log")
-    native, law = (runs[json.dumps({"mode": m, "scene": scene}, sort_keys=True)] for m in ("native", "law"))
+    runs = scene_runs(("native", "law"))
+    like_native(scene, runs[scene, "native"], runs[scene, "law"])
+
+
+def like_native(scene, native, law):
+    """A law's run of a scene against YADE's native one, within the differences the contract
+    keeps (below)."""
     assert len(native) == len(law) == 700
     fmax = MU * KN * DELTA * 1.01  # the largest friction force: mu*Fn, Fn ~ Kn*delta
     keys = set().union(*native)

@@ -10,7 +10,8 @@
 LAMMPS_DIR is a clean LAMMPS tree (4 Jul 2026: Debian sid's lammps_20260704+dfsg source), or
 only the files the patch changes from one (CHANGED). `git apply` or `patch -p1` in LAMMPS' top
 folder applies it. What it holds (ADDED: the tree's path <- this repository's file):
-- src/GRANULAR/: the sub-model's files, lammps_plugin/granular/;
+- src/GRANULAR/: the sub-model's files, lammps_plugin/granular/, and the law's core,
+  law_core/stick_slip_core.h, in LAMMPS' form (lammps_form: LAMMPS' banner, LAMMPS_NS);
 - doc/src/pair_granular.rst: the sub-model in the tangential list, its description and
   equations, its extra single() values, its restriction and the paper's reference (the
   passages in lammps_plugin/patch/doc/, each put at a place of the page found by ANCHORS);
@@ -42,9 +43,52 @@ ANCHORS = (
 )
 
 
+CORE = REPO / "law_core" / "stick_slip_core.h"
+BANNER = """\
+/* -*- c++ -*- ----------------------------------------------------------
+   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
+   https://www.lammps.org/, Sandia National Laboratories
+   LAMMPS development team: developers@lammps.org
+
+   Copyright (2003) Sandia Corporation.  Under the terms of Contract
+   DE-AC04-94AL85000 with Sandia Corporation, the U.S. Government retains
+   certain rights in this software.  This software is distributed under
+   the GNU General Public License.
+
+   See the README file in the top-level LAMMPS directory.
+------------------------------------------------------------------------- */
+
+/* ----------------------------------------------------------------------
+   Contributing authors: the stickslip developers
+   The engine-free core of the stick-slip friction model of Khellaf and
+   Mansouri (2024), equations numbered as in the paper: plain doubles in
+   and out, for one contact and one step. The tangential sub-model
+   stick_slip turns the spring into its tangent plane, builds the trial
+   force and, in step timing, tests the slip as linear_history does (so
+   that, at mu_k = mu_s, it gives that model's results bit for bit); the
+   rest of the law is here.
+------------------------------------------------------------------------- */
+"""
+# the sub-model's line that names the core's namespace in this repository (gone in LAMMPS' form)
+CORE_USING = "using stickslip::StickSlipCore;"
+
+
+def lammps_form(path, text):
+    """A file as the patch adds it to LAMMPS' tree: the law's core with LAMMPS' banner in
+    LAMMPS_NS (law_core/ keeps it engine-neutral for LIGGGHTS and YADE), the sub-model without
+    the line that reaches for the core's own namespace."""
+    if path == CORE:
+        body = text[text.index("#ifndef STICKSLIP_STICK_SLIP_CORE_H"):]
+        body = body.replace("STICKSLIP_STICK_SLIP_CORE_H", "LMP_STICK_SLIP_CORE_H")
+        body = body.replace("namespace stickslip {", "namespace LAMMPS_NS {")
+        return BANNER + "\n" + body.replace("}    // namespace stickslip", "}    // namespace LAMMPS_NS")
+    return "".join(line for line in text.splitlines(keepends=True) if CORE_USING not in line)
+
+
 def added():
     """{path in LAMMPS' tree: file of this repository} of the files the patch adds."""
     files = {f"src/GRANULAR/{f.name}": f for f in sorted((PLUGIN / "granular").iterdir())}
+    files["src/GRANULAR/stick_slip_core.h"] = CORE
     files.update({f"examples/granular/{f.name}": f for f in sorted((PLUGIN / "patch" / "examples").iterdir())})
     for part in ("granular", "force-styles"):
         files.update({f"unittest/{part}/tests/{f.name}": f for f in sorted((PLUGIN / "unittest" / part).iterdir())
@@ -118,7 +162,7 @@ def patch(tree):
     for path, source in added().items():
         if (tree / path).exists():
             raise SystemExit(f"lammps_patch: {tree / path} exists: give a clean LAMMPS tree (the patch adds it)")
-        parts.append(_diff(path, None, source.read_text()))
+        parts.append(_diff(path, None, lammps_form(source, source.read_text())))
     return "".join(parts)
 
 

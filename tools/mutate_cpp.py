@@ -3,14 +3,14 @@
 """Small deliberate bugs in the C++ law, each built and run against the tests: does the
 suite see it? (issue 31 item 5; the README's test section quotes the last result.)
 
-    .venv/bin/python tools/mutate_cpp.py [--engine liggghts|lammps|deme] [--only ID ...] [--wide]
+    .venv/bin/python tools/mutate_cpp.py [--engine liggghts|lammps|lammps_granular|yade_cpp|deme] [--only ID ...] [--wide]
 
 For each mutant: copy the engine's source folder, with the law's core beside it, into
 build/mutants/<engine>/src (the repository's layout; its files are never touched), apply the
 mutant to the copy, rebuild in
 build/mutants/<engine>/build, and run the engine's test selection with the adapter
-pointed at that build (STICKSLIP_LIGGGHTS_BUILD, STICKSLIP_LAMMPS_BUILD; DEM-Engine's force
-model: STICKSLIP_DEME_SHIM_BUILD, its CPU build for the tests). A mutant is found by the
+pointed at that build (STICKSLIP_LIGGGHTS_BUILD, STICKSLIP_LAMMPS_BUILD, STICKSLIP_YADE_LAW_BUILD;
+DEM-Engine's force model: STICKSLIP_DEME_SHIM_BUILD, its CPU build for the tests). A mutant is found by the
 text it changes (a regular expression, whitespace-insensitive, that must match exactly
 `count` times), never by line number: a mutant whose text is not found, or found a different
 number of times, is an ERROR in the summary and makes the exit status 2, never a silent
@@ -26,7 +26,7 @@ Release build as ./run.sh setup makes it (the large scenes run 3-5x faster there
 An engine is one entry in ENGINES: its source folder, the file its part of the law lives in
 (a mutant may name another file), the environment variable its adapter reads, its test
 selections, its configure arguments, and its mutants: its own (the same kinds, found in its
-own text) and the core's (CORE_MUTANTS, lammps_plugin/granular/stick_slip_core.h), which every
+own text) and the core's (CORE_MUTANTS, law_core/stick_slip_core.h), which every
 engine that includes the core must kill. DEM-Engine's float force model is its own copy.
 """
 from __future__ import annotations
@@ -66,12 +66,13 @@ class Engine:
     cmake_args: tuple = ()  # configure arguments beyond the build type
     builder: object = None  # build(src, out, quick, cmake_args) for an engine built otherwise (None: cmake -S src)
     # folders and files copied beside `source`: the law's core, the project's version header
-    copies: tuple = ("lammps_plugin/granular", "lammps_plugin/stickslip_version.h")
+    copies: tuple = ("lammps_plugin/granular", "law_core", "lammps_plugin/stickslip_version.h")
 
 
-# The law's engine-free core, included by LIGGGHTS, LAMMPS 2021's styles and the LAMMPS
-# sub-model: one list, run on each of the three (`--engine`); each must kill every mutant.
-CORE = "lammps_plugin/granular/stick_slip_core.h"
+# The law's engine-free core, included by LIGGGHTS, LAMMPS 2021's styles, the LAMMPS sub-model
+# and YADE's compiled law: one list, run on each of the four (`--engine`); each must kill every
+# mutant.
+CORE = "law_core/stick_slip_core.h"
 CORE_MUTANTS = (
     Mutant("core_threshold_gt", "> for >= at the threshold",
            "static bool slips(double force, double threshold) { return force >= threshold; }",
@@ -169,13 +170,12 @@ LAW_H, PAIR_CPP, WALL_CPP = ("lammps_plugin/stick_slip_law.h", "lammps_plugin/pa
                              "lammps_plugin/fix_wall_gran_stickslip.cpp")
 LAMMPS_MUTANTS = (
     Mutant("fmin_step_0.3pct", "Fmin off by 0.3 %",
-           "const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;",
-           "const double ratio = sum > 0.0 ? c.kin * fnabs * 1.003 / std::sqrt(sum) : 0.0;"),
+           "drop_to(fs, c.kin * fnabs, std::sqrt(sum),", "drop_to(fs, c.kin * fnabs * 1.003, std::sqrt(sum),"),
     Mutant("fmin_exact_0.3pct", "Fmin off by 0.3 %",
            "c.kin * fnabs, c.ratio, s.reset_total, stick);", "c.kin * fnabs * 1.003, c.ratio, s.reset_total, stick);"),
     Mutant("threshold_unsquared", "> for >= at the threshold",
-           "bool slipped = LAMMPS_NS::StickSlipCore::slips(sum, limit * limit);",
-           "bool slipped = LAMMPS_NS::StickSlipCore::slips(sum, limit);"),
+           "bool slipped = stickslip::StickSlipCore::slips(sum, limit * limit);",
+           "bool slipped = stickslip::StickSlipCore::slips(sum, limit);"),
     Mutant("reset_total_sign", "sign error in the spring reset",
            "D[k] = ratio * (D[k] + dv) - dv;", "D[k] = ratio * (D[k] + dv) + dv;"),
     Mutant("dashpot_sign", "sign error in the dashpot",
@@ -201,8 +201,8 @@ LAMMPS_MUTANTS = (
     Mutant("single_wrong_pair", "a per-type-pair coefficient read from the wrong pair",
            "const Coeffs &c = coeffs[itype][jtype];", "const Coeffs &c = coeffs[itype][itype];", file=PAIR_CPP),
     Mutant("reset_total_ignored_step", "the reset rule `total` ignored",
-           "if (!s.reset_total) LAMMPS_NS::StickSlipCore::reset(fs, nullptr, kt, false, D);",
-           "LAMMPS_NS::StickSlipCore::reset(fs, nullptr, kt, false, D);"),
+           "if (!s.reset_total) stickslip::StickSlipCore::reset(fs, nullptr, kt, false, D);",
+           "stickslip::StickSlipCore::reset(fs, nullptr, kt, false, D);"),
     Mutant("recontact_keeps_spring_pair", "re-contact does not start from a zero spring",
            "for (int m = 0; m < dnum; m++) hist[m] = 0.0; continue;", "continue;", file=PAIR_CPP),
     # (the end of the statement only: the LAMMPS speed work renames the history array)
@@ -304,7 +304,7 @@ LAMMPS_GRANULAR_MUTANTS = (
            "dt, Fscrit, fncrit * kin, ratio, reset_total, stick);",
            "dt, Fscrit, fncrit * kin * 1.003, ratio, reset_total, stick);"),
     Mutant("rescale_fmin_0.3pct", "Fmin off by 0.3 %",
-           "rescale_factor(gm, fncrit * kin, magfs)", "rescale_factor(gm, fncrit * kin * 1.003, magfs)"),
+           "StickSlipCore::drop_to(F, fncrit * kin, magfs,", "StickSlipCore::drop_to(F, fncrit * kin * 1.003, magfs,"),
     Mutant("dashpot_sign", "sign error in the dashpot",
            "for (int i = 0; i < 3; i++) F[i] = -ks * D[i] + fdamp[i];",
            "for (int i = 0; i < 3; i++) F[i] = -ks * D[i] - fdamp[i];"),
@@ -343,7 +343,7 @@ def build_lammps_2025(src: Path, out: Path, quick=True, cmake_args=()):
     if not (lammps / ".complete").exists():
         shutil.rmtree(lammps, ignore_errors=True)
         shutil.copytree(REPO / "build" / "lammps_2025" / "source", lammps)
-    for f in src.iterdir():
+    for f in [*src.iterdir(), src.parent.parent / CORE]:  # (the copies keep the repository's layout)
         target = lammps / "src" / "GRANULAR" / f.name
         if not target.exists() or target.read_bytes() != f.read_bytes():
             shutil.copy(f, target)
@@ -356,7 +356,54 @@ def build_lammps_2025(src: Path, out: Path, quick=True, cmake_args=()):
     return proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
 
 
+# YADE's compiled law: its host part, yade_law/compiled/StickSlipPM.cpp (the normal force, the
+# lever arms, the turn of the spring, the trial force, the record), built against Debian's YADE
+# with the headers ./run.sh setup extracted
+YADE_CPP = "yade_law/compiled/StickSlipPM.cpp"
+YADE_CPP_MUTANTS = (
+    Mutant("yade_turn_loses_length", "a turned history that loses its length",
+           "if (new2 > 0) D *= std::sqrt(old2 / new2);", ""),
+    Mutant("yade_dashpot_sign", "sign error in the dashpot", "F                   = -ks * D - nu_s * Vs;",
+           "F                   = -ks * D + nu_s * Vs;"),
+    Mutant("yade_fmin_0.3pct", "Fmin off by 0.3 %", "const Real fmin     = Core::kinetic(mu_s, phys.mu_k) * fn;",
+           "const Real fmin     = Core::kinetic(mu_s, phys.mu_k) * fn * 1.003;"),
+    Mutant("yade_lever_arm_radius", "lever arms at the radius, not midway in the overlap",
+           "const Real half = 0.5 * delta;", "const Real half = 0.0;"),
+    Mutant("yade_wall_point_centre", "a wall's velocity taken at its centre, not at its surface",
+           "a1 = (s2.pos + shift2 - (r2 - delta) * n) - s1.pos;", "a1 = Vector3r::Zero();"),
+    Mutant("yade_shift_velocity_sign", "the periodic image's velocity with the wrong sign",
+           "Vector3r vrel = s1.vel - s2.vel - shiftVel;", "Vector3r vrel = s1.vel - s2.vel + shiftVel;"),
+    Mutant("yade_spring_kept_at_zero_overlap", "a contact at zero overlap keeps its spring",
+           "D = F = Vector3r::Zero();", "F = Vector3r::Zero();"),
+    Mutant("yade_slip_counted_twice", "a wrong slip count in the record", "phys.slips++;", "phys.slips += 2;"),
+    Mutant("yade_no_law_torque", "the law's torque left out",
+           "addTorque(id1, -c1x.cross(phys.normalForce) + a1.cross(F), scene);",
+           "addTorque(id1, -c1x.cross(phys.normalForce), scene);"),
+    Mutant("yade_setup_step_loads", "the set-up evaluation loads the springs",
+           "const Real dt = scene->iter == setupIter ? Real(0) : scene->dt;", "const Real dt = scene->dt;"),
+    Mutant("yade_nan_passes", "a non-finite contact that does not stop the run",
+           "if (!std::isfinite(static_cast<double>(fn + F[0] + F[1] + F[2]))) {", "if (false) {"),
+) + CORE_MUTANTS
+
+
+def build_yade_law(src: Path, out: Path, quick=True, cmake_args=()):
+    """The compiled YADE law in `src` (yade_law/compiled with law_core beside it) built in `out`
+    against the headers ./run.sh setup extracted (build/yade_source/src): Release always (the
+    suite's YADE scenes are short; a mutant recompiles one file, ~2 min on 2 cores)."""
+    headers = REPO / "build" / "yade_source" / "src"
+    if not (out / "CMakeCache.txt").exists():
+        subprocess.run(["cmake", "-S", str(src), "-B", str(out), "-DCMAKE_BUILD_TYPE=Release",
+                        f"-DYADE_SOURCE={headers}"], check=True, capture_output=True, text=True)
+    proc = subprocess.run(["cmake", "--build", str(out), "-j", "2"], capture_output=True, text=True)
+    return proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+
+
 ENGINES = {
+    "yade_cpp": Engine(
+        source="yade_law/compiled", law_file=YADE_CPP, build_env="STICKSLIP_YADE_LAW_BUILD",
+        fast=("tests/test_law_contract.py", "-k", "yade_cpp"),
+        wide=("tests/test_yade_compiled.py", "tests/test_law_contract.py", "-k", "yade_cpp or compiled"),
+        mutants=YADE_CPP_MUTANTS, builder=build_yade_law, copies=("law_core",)),
     "lammps_granular": Engine(
         source="lammps_plugin/granular", law_file=SUB_CPP, build_env="STICKSLIP_LAMMPS_GRANULAR",
         fast=("tests/test_law_contract.py", "-k", "lammps_granular"),
@@ -431,7 +478,7 @@ def main(argv=None):
     eng = ENGINES[args.engine]
     mutants = [m for m in eng.mutants if not args.only or m.id in args.only]
     work = REPO / "build" / "mutants" / args.engine
-    # the copies keep the repository's layout (the LIGGGHTS plugin reaches the core at ../lammps_plugin)
+    # the copies keep the repository's layout (the LIGGGHTS plugin reaches the core at ../law_core)
     root, out, out_release = work / "src", work / "build", work / "build-release"
     if eng.builder is not None:  # (one build serves both selections)
         out_release = out

@@ -1,20 +1,23 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""Cost of the Python stick-slip law against YADE's native frictional law, same run.
+"""Cost of the stick-slip law, compiled and in Python, against YADE's native frictional law,
+measured side by side in one run.
 
-    yade -n -x bench_yade_law.py [--n 20] [--steps 30] [--reps 5] [--no-rotation] [--shake V]
-                                 [--slip-timing step|exact]
+    build/yade_law/yade-stickslip -n -x bench_yade_law.py [--n 20] [--steps 30] [--reps 5]
+        [--no-rotation] [--shake V] [--slip-timing step|exact] [--kinds native,compiled,python,normal]
 
 Builds an n x n x n cubic lattice of overlapping spheres (3 n^2 (n-1) contacts,
 22 800 for n = 20) with small random velocities (up to --shake m/s; the default 1e-3
 keeps every contact; 0.05 opens and closes contacts during the run), then, several
-times over and interleaved (so that a busy machine slows all three alike):
-  A. native: ViscElMat with ks > 0 and friction, Law2_ScGeom_ViscElPhys_Basic;
-  B. stick-slip: the native normal force + the PyRunner law (yade_law/stickslip_yade/);
-  C. normal only: B without the PyRunner (ks = 0, no friction), to isolate the law.
+times over and interleaved (so that a busy machine slows them all alike):
+  native: ViscElMat with ks > 0 and friction, Law2_ScGeom_ViscElPhys_Basic;
+  compiled: the compiled law (yade_law/compiled/; YADE started through its launcher);
+  python: the native normal force + the PyRunner law (yade_law/stickslip_yade/);
+  normal: YADE's ViscEl law without the PyRunner (ks = 0, no friction), to isolate the
+  Python law's own cost (python - normal).
 The whole step is timed in CPU time of the thread running it (time.thread_time around
-O.step: the figure a user feels, less the time other processes took the core); the law's
-cost is B - C. YADE's own engine timers (O.timingEnabled, wall time) are printed too.
-Medians over the repetitions; figures per contact per step.
+O.step: the figure a user feels, less the time other processes took the core). YADE's own
+engine timers (O.timingEnabled, wall time) are printed too. Medians over the repetitions,
+and each ratio's spread over them (its smallest and largest); figures per contact per step.
 """
 import argparse
 import json
@@ -38,11 +41,18 @@ ap.add_argument("--reps", type=int, default=5)
 ap.add_argument("--no-rotation", action="store_true")
 ap.add_argument("--shake", type=float, default=1e-3)
 ap.add_argument("--slip-timing", default="step", choices=("step", "exact"))
+ap.add_argument("--kinds", default="native,compiled,python,normal",
+                help="which to run, of native, compiled, python, normal (compiled needs the launcher)")
+ap.add_argument("--callgrind", action="store_true",
+                help="run ./callgrind_on.sh before the timed steps (under callgrind's --instr-atstart=no: only "
+                     "those steps are counted; stickslip/bench/yade.py)")
 args = ap.parse_args(sys.argv[1:])
 
 R, KN, KS, NU_N, NU_S, RHO = 1e-3, 1e5, 8e4, 0.0, 0.0, 2600.0
 ROT = not args.no_rotation
-KINDS = ("native", "stickslip", "normal")
+KINDS = tuple(args.kinds.split(","))
+if set(KINDS) - {"native", "compiled", "python", "normal"}:
+    ap.error(f"--kinds {args.kinds}: each must be one of native, compiled, python, normal")
 
 
 def build(kind):
@@ -62,9 +72,9 @@ def build(kind):
                 if not ROT:
                     b.state.blockedDOFs = "XYZ"
                 O.bodies.append(b)
-    if kind == "stickslip":
-        timing = {} if args.slip_timing == "step" else {"slip_timing": args.slip_timing}  # (older laws: no option)
-        O.engines = stickslip_engines(ks=KS, nu_s=NU_S, mu_s=0.5, mu_k=0.45, rotation=ROT, **timing)
+    if kind in ("compiled", "python"):
+        O.engines = stickslip_engines(ks=KS, nu_s=NU_S, mu_s=0.5, mu_k=0.45, rotation=ROT, slip_timing=args.slip_timing,
+                                      backend="cpp" if kind == "compiled" else "python")
     else:
         O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb()]),
                      InteractionLoop([Ig2_Sphere_Sphere_ScGeom()], [Ip2_ViscElMat_ViscElMat_ViscElPhys()],
@@ -95,36 +105,47 @@ def measure():
 res = {k: [] for k in KINDS}
 contacts, full_reads = {}, []
 for rep in range(args.reps):
-    for kind in KINDS:
+    for kind in (KINDS if rep % 2 == 0 else KINDS[::-1]):  # (the order alternates: no side always goes first)
         build(kind)
+        if args.callgrind:
+            os.system("./callgrind_on.sh")
         contacts[kind], t = measure()
         res[kind].append(t)
-        if kind == "stickslip":
-            full_reads.append(getattr(stickslip_law, "full_reads", 1) - 1)  # noqa: F821 -- the first step reads all
+        if kind == "python":
+            full_reads.append(stickslip_law.full_reads - 1)  # noqa: F821 -- the first step reads all
 
 
 def med(kind, name):
     return statistics.median(r.get(name, 0.0) for r in res[kind])
 
 
-native, law_step, normal = med("native", "cpu"), med("stickslip", "cpu"), med("normal", "cpu")
-law = law_step - normal
-print(f"contacts: native {contacts['native']}, stick-slip {contacts['stickslip']}; {args.steps} steps x "
-      f"{args.reps} repetitions, rotation {'on' if ROT else 'off'}, velocities up to {args.shake:g} m/s, "
-      f"slip timing {args.slip_timing}; "
-      f"full reads of the interaction set in the timed steps: {max(full_reads)}")
+def ratio(kind):
+    """The whole step of `kind` against the native law's: the median of the repetitions'
+    ratios, and their smallest and largest (each repetition measures both back to back)."""
+    r = [a["cpu"] / b["cpu"] for a, b in zip(res[kind], res["native"])]
+    return statistics.median(r), min(r), max(r)
+
+
+out = {"contacts": contacts, "rotation": ROT, "reps": args.reps, "shake": args.shake, "slip_timing": args.slip_timing,
+       "steps": args.steps, "rounds": {kind: [r["cpu"] for r in res[kind]] for kind in KINDS}}
+print(f"contacts: {contacts}; {args.steps} steps x {args.reps} repetitions, rotation {'on' if ROT else 'off'}, "
+      f"velocities up to {args.shake:g} m/s, slip timing {args.slip_timing}")
 print("median cost per contact per step (us, CPU time of the stepping thread):")
-print(f"  whole step, native frictional             {native:8.3f}")
-print(f"  whole step, stick-slip                    {law_step:8.3f}")
-print(f"  ratio stick-slip / native, whole step     {law_step / native:8.2f}")
-print(f"  whole step, normal law only (no friction) {normal:8.3f}")
-print(f"  stick-slip law alone (difference)         {law:8.3f}")
-print(f"  (YADE timers, wall: PyRunner {med('stickslip', 'PyRunner'):.3f}, native InteractionLoop "
-      f"{med('native', 'InteractionLoop'):.3f}; wall whole step native {med('native', 'wall'):.3f}, "
-      f"stick-slip {med('stickslip', 'wall'):.3f})")
-print("RESULT " + json.dumps({"contacts": contacts["stickslip"], "rotation": ROT, "reps": args.reps, "shake": args.shake,
-                             "slip_timing": args.slip_timing,
-                             "step_native_us": native, "step_stickslip_us": law_step, "ratio_step": law_step / native,
-                             "step_normal_us": normal, "law_us": law,
-                             "wall_step_native_us": med("native", "wall"),
-                             "wall_step_stickslip_us": med("stickslip", "wall"), "full_reads": max(full_reads)}))
+for kind in KINDS:
+    out[f"step_{kind}_us"] = med(kind, "cpu")
+    out[f"wall_step_{kind}_us"] = med(kind, "wall")
+    line = f"  whole step, {kind:9s} {med(kind, 'cpu'):8.3f}"
+    if kind != "native" and "native" in KINDS:
+        m, lo, hi = ratio(kind)
+        out[f"ratio_{kind}"], out[f"ratio_{kind}_range"] = m, [lo, hi]
+        line += f"   {m:6.3f} x native ({lo:.3f}-{hi:.3f})"
+    print(line)
+if "python" in KINDS and "normal" in KINDS:
+    out["python_law_us"] = med("python", "cpu") - med("normal", "cpu")
+    out["full_reads"] = max(full_reads)
+    print(f"  the Python law alone (python - normal) {out['python_law_us']:8.3f}; full reads of the interaction set "
+          f"in the timed steps: {max(full_reads)}")
+if "compiled" in KINDS and "native" in KINDS:
+    print(f"  (YADE timers, wall: InteractionLoop native {med('native', 'InteractionLoop'):.3f}, "
+          f"compiled {med('compiled', 'InteractionLoop'):.3f})")
+print("RESULT " + json.dumps(out))

@@ -2,6 +2,7 @@
 """The paper's case 1 (section 3.1) in YADE: a grain dragged at constant speed on a floor.
 
     yade -n -x example_drag.py [--reset spring|total] [--csv out.csv] [--steps 2500]
+    build/yade_law/yade-stickslip -n -x example_drag.py --backend cpp    # the compiled law
 
 The paper is 2D (per metre of thickness). YADE is 3D, so the disk becomes an
 "equivalent sphere" with the disk's mass per unit thickness, m = rho*pi*r^2, moving
@@ -27,6 +28,7 @@ ap.add_argument("--csv")
 ap.add_argument("--steps", type=int, default=2500)  # 5e-3 s: static phase + ~10 periods
 ap.add_argument("--dt", type=float, default=2e-6)
 ap.add_argument("--nu_s", type=float, default=33.10)
+ap.add_argument("--backend", default="python", help="python, or cpp: the compiled law (yade_law/README.md)")
 args = ap.parse_args(sys.argv[1:])
 
 r, rho, g, V = 0.002, 2600.0, 9.81, 1e-5  # Table 2 and section 3.1
@@ -41,7 +43,7 @@ b.state.blockedDOFs = "xzXYZ"  # x imposed, stays in the xy-plane, no rotation
 b.state.vel = Vector3(V, 0.0, 0.0)
 grain = O.bodies.append(b)
 O.engines = stickslip_engines(ks=ks, nu_s=nu_s, mu_s=mu_s, mu_k=mu_k, reset=args.reset,
-                              gravity=(0.0, -g, 0.0), rotation=False)
+                              gravity=(0.0, -g, 0.0), rotation=False, backend=args.backend)
 O.dt = args.dt
 law = stickslip_law  # noqa: F821 -- published in builtins by stickslip_engines
 

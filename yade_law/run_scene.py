@@ -73,7 +73,7 @@ def build(sc):
     O.engines = stickslip_engines(ks=c["ks"], nu_s=c["nu_s"] if eff["tangential_damping"] else 0.0,
                                   mu_s=c["mu_s"], mu_k=c["mu_k"], reset=c["reset"], slip_timing=c["slip_timing"],
                                   gravity=sc["gravity"] if eff["gravity"] else (0.0, 0.0, 0.0),
-                                  rotation=eff["rotation"])
+                                  rotation=eff["rotation"], backend=sc.get("backend", "python"))
     O.dt = sc["dt"]
     return ids, [TurningWall(b, w, sc["dt"]) for b, w in turning]
 

@@ -34,6 +34,7 @@
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
 using namespace MathExtra;
+using stickslip::StickSlipCore;    // (the law's core; tools/lammps_patch.py puts it in LAMMPS_NS)
 
 // as linear_history and mindlin: the spring is turned into the tangent plane only when its
 // normal part carries more than EPSILON of the threshold
@@ -276,8 +277,9 @@ template <int OPTIONS> void GranSubModTangentialStickSlip::forces()
       // the force the law would apply now, with no time passing
       for (int i = 0; i < 3; i++) fs[i] = -ks * D[i] - damp * v[i];
       const double magfs = len3(fs);
-      if (StickSlipCore::slips(magfs, Fscrit))
-        scale3(magfs > 0.0 && lensq3(D) != 0.0 ? fncrit * kin / magfs : 0.0, fs);
+      if (StickSlipCore::slips(magfs, Fscrit))    // (a zero spring: no force, as the step below)
+        StickSlipCore::drop_to(fs, fncrit * kin, lensq3(D) != 0.0 ? magfs : 0.0,
+                               StickSlipCore::stock_ratio);
     }
     return;
   }
@@ -313,7 +315,9 @@ template <int OPTIONS> void GranSubModTangentialStickSlip::forces()
     if (slipped) {
       if (lensq3(D) != 0.0) {
         // the force drops to Fmin along the trial force (rescaled as the host's stock does)
-        scale3(magfs > 0.0 ? rescale_factor(gm, fncrit * kin, magfs) : 0.0, F);
+        StickSlipCore::drop_to(F, fncrit * kin, magfs, [this](double fmin, double mag) {
+          return rescale_factor(gm, fmin, mag);
+        });
         StickSlipCore::reset(F, fdamp, ks, reset_total, D);
       } else {
         // as linear_history: a zero spring (a new contact in a set-up evaluation) gets no

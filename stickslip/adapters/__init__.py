@@ -20,7 +20,7 @@ from typing import Callable, Protocol
 
 import pandas as pd
 
-ENGINES = ("pyref", "liggghts", "yade", "lammps", "lammps_granular")
+ENGINES = ("pyref", "liggghts", "yade", "yade_cpp", "lammps", "lammps_granular")
 # Engines that ./run.sh builds from Debian's source packages only behind its set-up switch
 # (STICKSLIP_SOURCE_BUILDS, run.sh): the default set-up lacks them, so a full install needs
 # one only where the switch asks for it (CI's does). Engine -> the switch's words (any of them

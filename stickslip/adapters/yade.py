@@ -59,7 +59,9 @@ def scene_dict(scene):
     }
 
 
-def run(scene, out_dir, progress=None):
+def run(scene, out_dir, progress=None, launcher="yade", backend="python"):
+    """The scene in YADE: `launcher` starts YADE (the compiled law's launcher for backend
+    "cpp", stickslip/adapters/yade_cpp.py)."""
     scene.refuse_unsupported("YADE")
     if scene.contact.law != "stick_slip":
         raise ValueError(f"the YADE law implements stick_slip only, not {scene.contact.law}")
@@ -67,13 +69,13 @@ def run(scene, out_dir, progress=None):
         raise ValueError("output.energy: the YADE adapter does not record the energy columns")
     work = Path(out_dir).resolve() / "yade"  # absolute: yade runs with work as its cwd
     work.mkdir(parents=True, exist_ok=True)
-    (work / "scene.json").write_text(json.dumps(scene_dict(scene), indent=1))
+    (work / "scene.json").write_text(json.dumps(dict(scene_dict(scene), backend=backend), indent=1))
     csv_path = work / "timeseries_raw.csv"
     t0 = time.perf_counter()
     wall, error = None, None
     with open(work / "yade.log", "w") as log:
         env = dict(os.environ, STICKSLIP_YADE_LAW=str(LAW_FOLDER))
-        p = subprocess.Popen(["yade", "-n", "-x", str(RUNNER), str(work / "scene.json"), str(csv_path)],
+        p = subprocess.Popen([str(launcher), "-n", "-x", str(RUNNER), str(work / "scene.json"), str(csv_path)],
                              stdout=subprocess.PIPE, stderr=log, text=True, cwd=work, env=env)
         for line in p.stdout:
             log.write(line)

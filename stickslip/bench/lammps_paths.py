@@ -54,9 +54,10 @@ MARKERS = {
         "double meff = rmass[i];": "touching",
     },
     "stick_slip_law.h": {
-        "const double ratio = sum > 0.0 ? c.kin * fnabs / std::sqrt(sum) : 0.0;": "step: slip (reset to Fmin)",
+        "const double ratio = stickslip::StickSlipCore::drop_to(fs, c.kin * fnabs, std::sqrt(sum),":
+            "step: slip (reset to Fmin)",
     },
-    "granular/stick_slip_core.h": {
+    "../law_core/stick_slip_core.h": {
         "for (int i = 0; i < 3; i++) F0[i] = F[i] + ksdt * vs[i];": "exact: every evaluation (E0)",
         "if (start_slips && T > 0.0 && !total": "exact: a slip in the step (E4 tested)",
         "F[i] = -a * vs[i];": "exact: E4 at the step's start (slides)",
@@ -72,8 +73,8 @@ MARKERS = {
         "const double n = std::floor(rest / L);": "E7 (closed form)",
     },
 }
-LAW_FILES = re.compile(r"lammps_plugin/(stick_slip_law\.h|granular/stick_slip_core\.h|wall_contact\.h|"
-                       r"pair_gran_hooke_stickslip\.cpp|fix_wall_gran_stickslip\.cpp)$")
+LAW_FILES = re.compile(r"(lammps_plugin/(stick_slip_law\.h|wall_contact\.h|pair_gran_hooke_stickslip\.cpp|"
+                       r"fix_wall_gran_stickslip\.cpp)|law_core/stick_slip_core\.h)$")
 STOCK = re.compile(r"PairGranHookeHistory::compute|FixWallGran::(post_force|hooke_history)")
 
 

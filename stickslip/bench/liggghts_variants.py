@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Variants of the LIGGGHTS plugin for the benchmark's analysis, made in the build that needs
 them: the law's files (liggghts_plugin/tangential_model_stick_slip.h and its core,
-lammps_plugin/granular/stick_slip_core.h) carry no hook for them. A variant's headers are
+law_core/stick_slip_core.h) carry no hook for them. A variant's headers are
 written into its build folder and put first on the plugin's include path (CMakeLists.txt's
 STICK_SLIP_HEADERS), in place of the law's:
 
@@ -25,7 +25,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 LAW = ROOT / "liggghts_plugin" / "tangential_model_stick_slip.h"
-CORE = ROOT / "lammps_plugin" / "granular" / "stick_slip_core.h"
+CORE = ROOT / "law_core" / "stick_slip_core.h"
 BUILDS = {"control": ROOT / "build" / "liggghts_control", "paths": ROOT / "build" / "liggghts_plugin_paths"}
 
 CLASS = "template<>\nclass TangentialModel<TANGENTIAL_STICK_SLIP> : public TangentialModelBase\n{"

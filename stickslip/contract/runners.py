@@ -9,7 +9,8 @@ A new engine is one more driver (a module here, reusing its adapter's script wri
 reading) and one entry in RUNNERS (tests/test_law_contract.py fails for an engine of
 stickslip.adapters.ENGINES that has neither an entry nor a reason in SHARED_KERNEL), and one
 in TYPE_PAIR_RUNNERS or NO_TYPE_PAIRS. Drivers here: pyref (below), LIGGGHTS (liggghts.py),
-LAMMPS' two routes (lammps.py); DEM-Engine's force model through its CPU shim (deme_shim.py).
+LAMMPS' two routes (lammps.py), YADE's compiled law (yade.py); DEM-Engine's force model through its
+CPU shim (deme_shim.py).
 """
 from __future__ import annotations
 
@@ -18,9 +19,11 @@ from ..adapters.lammps_family import fmt as _f
 from . import cases as lc
 from .lammps import run_lammps, run_lammps_granular, run_lammps_granular_type_pairs, run_lammps_type_pairs
 from .liggghts import run_liggghts, run_liggghts_type_pairs
+from .yade import run_yade_cpp
 
-# YADE's law calls pyref's kernel (yade_law/stickslip_yade/kernel.py imports pyref/laws.py):
-# the law's arithmetic there is pyref's; its own tests check its geometry and integration.
+# YADE's Python law calls pyref's kernel (yade_law/stickslip_yade/kernel.py imports pyref/laws.py):
+# the law's arithmetic there is pyref's; its own tests check its geometry and integration. YADE's
+# compiled law (yade_cpp) has arithmetic of its own and runs the contract (yade.py).
 SHARED_KERNEL = {"yade": "runs pyref's kernel (yade_law/stickslip_yade/kernel.py imports pyref/laws.py)"}
 # Engines of stickslip.adapters.OPTIONAL_ENGINES, whose hardware CI lacks: where their law's
 # own file runs every row without it.
@@ -94,8 +97,10 @@ def run_pyref(case):
     return out
 
 
-RUNNERS = {"pyref": run_pyref, "liggghts": run_liggghts, "lammps": run_lammps, "lammps_granular": run_lammps_granular}
+RUNNERS = {"pyref": run_pyref, "liggghts": run_liggghts, "lammps": run_lammps, "lammps_granular": run_lammps_granular,
+           "yade_cpp": run_yade_cpp}
 TYPE_PAIR_RUNNERS = {"liggghts": run_liggghts_type_pairs, "lammps": run_lammps_type_pairs,
                      "lammps_granular": run_lammps_granular_type_pairs}
 # Cases an engine cannot express, and why (the README's table shows them).
-NO_TYPE_PAIRS = {"pyref": "one material per scene: one mu_s, mu_k for every contact"}
+NO_TYPE_PAIRS = {"pyref": "one material per scene: one mu_s, mu_k for every contact",
+                 "yade_cpp": "the law's parameters are its Ip2 functor's: one mu_s, mu_k for every contact"}

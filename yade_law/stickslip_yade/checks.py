@@ -42,6 +42,16 @@ def flag(name, v):
     return bool(v)
 
 
+BACKENDS = ("python", "cpp")
+
+
+def backend(v):
+    """The law's implementation: the Python law (nothing to build) or the compiled one."""
+    if v not in BACKENDS:
+        raise ValueError(f"backend = {v!r}: must be one of {', '.join(BACKENDS)}")
+    return v
+
+
 def vector3(name, v):
     """Three finite numbers (a tuple, list, numpy array or Vector3) as a tuple of floats."""
     try:

@@ -59,6 +59,12 @@ def publish(law):
     builtins.stickslip_law = law
 
 
+def publish_view(view):
+    """The compiled law's view (compiled.CompiledLaw) as `builtins.stickslip_law`, where a
+    script finds the Python law too."""
+    builtins.stickslip_law = view
+
+
 def stickslip_runner(ks, nu_s, mu_s, mu_k, reset="spring", slip_timing="step", rotation=True, check=False):
     """The law's PyRunner, for an engine list of your own: place it right after the
     InteractionLoop and before NewtonIntegrator (yade_law/README.md, "Your own engine list").

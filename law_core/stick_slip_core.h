@@ -1,30 +1,15 @@
-/* -*- c++ -*- ----------------------------------------------------------
-   LAMMPS - Large-scale Atomic/Molecular Massively Parallel Simulator
-   https://www.lammps.org/, Sandia National Laboratories
-   LAMMPS development team: developers@lammps.org
+// SPDX-License-Identifier: GPL-2.0-or-later
+/* The engine-free core of the stick-slip friction law of Khellaf & Mansouri (2024), equations
+   numbered as in the paper: plain doubles in and out, for one contact and one step. Every C++
+   host includes this one file: LIGGGHTS' tangential model, LAMMPS' tangential sub-model
+   stick_slip and LAMMPS 2021's styles (lammps_plugin/), and YADE's compiled law (yade_law/).
+   Each host turns the spring into its tangent plane, builds the trial force and, in step
+   timing, tests the slip its own way (so that, at mu_k = mu_s, it gives its stock model's
+   results bit for bit); the rest of the law is here (docs/law.md). tools/lammps_patch.py
+   writes it in LAMMPS' own form for a LAMMPS tree. */
 
-   Copyright (2003) Sandia Corporation.  Under the terms of Contract
-   DE-AC04-94AL85000 with Sandia Corporation, the U.S. Government retains
-   certain rights in this software.  This software is distributed under
-   the GNU General Public License.
-
-   See the README file in the top-level LAMMPS directory.
-------------------------------------------------------------------------- */
-
-/* ----------------------------------------------------------------------
-   Contributing authors: the stickslip developers
-   The engine-free core of the stick-slip friction model of Khellaf and
-   Mansouri (2024), equations numbered as in the paper: plain doubles in
-   and out, for one contact and one step. Hosts: the tangential sub-model
-   stick_slip of the granular model, and the same law's older LAMMPS and
-   LIGGGHTS forms. Each host turns the spring into its tangent plane,
-   builds the trial force and, in step timing, tests the slip its own way
-   (so that, at mu_k = mu_s, it can give its stock model's results to the
-   last bit); the rest of the law is here.
-------------------------------------------------------------------------- */
-
-#ifndef LMP_STICK_SLIP_CORE_H
-#define LMP_STICK_SLIP_CORE_H
+#ifndef STICKSLIP_STICK_SLIP_CORE_H
+#define STICKSLIP_STICK_SLIP_CORE_H
 
 #include <algorithm>
 #include <cmath>
@@ -39,7 +24,7 @@
 #define STICK_SLIP_UNLIKELY(x) (x)
 #endif
 
-namespace LAMMPS_NS {
+namespace stickslip {
 
 class StickSlipCore {
  public:
@@ -62,6 +47,21 @@ class StickSlipCore {
   // the slip test: the trial force reaches the static threshold mu_s Fn (magnitudes or
   // squares of both)
   static bool slips(double force, double threshold) { return force >= threshold; }
+
+  // fmin / |F| in one division: the rescale of most stock models (drop_to's default)
+  static double stock_ratio(double fmin, double mag) { return fmin / mag; }
+
+  /* Step timing's drop at a slip (eq. 8): the trial force F, of length mag, scaled along
+     itself to fmin (a zero force stays zero). ratio(fmin, mag) is the host's stock arithmetic
+     for fmin / mag: each stock model rounds its rescale its own way, and at mu_k = mu_s the
+     host's stock results, bit for bit, need its own. Returns the factor applied. */
+  template <class Ratio>
+  static STICK_SLIP_ALWAYS_INLINE double drop_to(double *F, double fmin, double mag, Ratio ratio)
+  {
+    const double s = mag > 0.0 ? ratio(fmin, mag) : 0.0;
+    for (int i = 0; i < 3; i++) F[i] *= s;
+    return s;
+  }
 
   /* eq. 8: the spring after a slip that applies the force F. The spring alone carries F
      (the paper), or with reset total the spring and the dashpot's force fdamp together:
@@ -292,6 +292,6 @@ class StickSlipCore {
   }
 };
 
-}    // namespace LAMMPS_NS
+}    // namespace stickslip
 
 #endif
