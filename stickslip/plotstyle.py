@@ -2,8 +2,8 @@
 """What every report figure shares: one line style per engine, and saving a figure."""
 from __future__ import annotations
 
-ENGINE_LINES = {"pyref": "-", "liggghts": "--", "yade": ":", "lammps": "-.", "lammps_granular": (0, (5, 2, 1, 2, 1, 2)),
-                "deme": (0, (1, 3))}
+ENGINE_LINES = {"pyref": "-", "liggghts": "--", "yade": ":", "yade_cpp": (0, (3, 1, 1, 1)), "lammps": "-.",
+                "lammps_granular": (0, (5, 2, 1, 2, 1, 2)), "deme": (0, (1, 3))}
 
 
 def line(engine):

@@ -121,10 +121,12 @@ def _one_line(e):
 # Rough seconds per step (a part per step and one per grain or wall) and to start an
 # engine, only to run the longest jobs first (stickslip/parallel.py). On the paper's
 # small scenes a step costs about the same whatever the grains (pyref: numpy's per-call
-# overhead; YADE: its Python law), so the part per step dominates there.
-_STEP = {"pyref": 5e-5, "liggghts": 2e-6, "yade": 2.5e-4, "lammps": 5e-6, "lammps_granular": 5e-6}
-_PER_OBJECT = {"pyref": 1e-6, "liggghts": 3e-7, "yade": 5e-6, "lammps": 3e-7, "lammps_granular": 3e-7}
-_START = {"pyref": 0.0, "liggghts": 0.5, "yade": 1.5, "lammps": 0.5, "lammps_granular": 0.5}
+# overhead; YADE: its Python law; the compiled YADE law: the runner's Python per step), so the
+# part per step dominates there.
+_STEP = {"pyref": 5e-5, "liggghts": 2e-6, "yade": 2.5e-4, "yade_cpp": 1.5e-5, "lammps": 5e-6, "lammps_granular": 5e-6}
+_PER_OBJECT = {"pyref": 1e-6, "liggghts": 3e-7, "yade": 5e-6, "yade_cpp": 3e-7, "lammps": 3e-7,
+               "lammps_granular": 3e-7}
+_START = {"pyref": 0.0, "liggghts": 0.5, "yade": 1.5, "yade_cpp": 2.0, "lammps": 0.5, "lammps_granular": 0.5}
 
 
 def cost(scene, engine, steps=None) -> float:

@@ -57,11 +57,14 @@ def timed(rounds, steps, n, timing="step", rotation=True, shake=1e-3, kinds=("na
 def counted(steps, n, timing="step", kinds=("native", "compiled")):
     """{kind: instructions per contact-step of YADE's whole step}, from callgrind."""
     out = {}
+    # YADE itself under callgrind, from the compiled law's prefix (the launcher would start it
+    # through a shell); the launcher's layout check first, as the launcher would run it
+    subprocess.run([str(LAUNCHER), "-n", "-x", "/dev/null"], check=True, capture_output=True, timeout=600)
     for kind in kinds:
         with tempfile.TemporaryDirectory(prefix="yade-callgrind-") as tmp:
-            cmd = [str(LAUNCHER), "-n", "-x", str(BENCH), "--reps", "1", "--steps", str(steps), "--n", str(n),
+            cmd = ["yade", "-n", "-x", str(BENCH), "--reps", "1", "--steps", str(steps), "--n", str(n),
                    "--slip-timing", timing, "--kinds", kind, "--callgrind"]
-            env = dict(os.environ, OMP_NUM_THREADS="1")
+            env = dict(os.environ, OMP_NUM_THREADS="1", YADE_PREFIX=str(LAUNCHER.parent / "prefix"))
             profiles = callgrind.count(cmd, tmp, function=STEP, env=env, on_request=True)
             got = [x for x in (Path(tmp) / "callgrind.txt").read_text().splitlines() if x.startswith("RESULT ")]
             contacts = json.loads(got[-1][7:])["contacts"][kind]

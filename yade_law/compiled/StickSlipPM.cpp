@@ -38,6 +38,8 @@ namespace {
 		if (!std::isfinite(static_cast<double>(v))) refuse(std::string(name) + " = " + number(v) + ": must be a finite number");
 	}
 
+	bool isSphere(const Body& b) { return b.shape && b.shape->getClassIndex() == Sphere::getClassIndexStatic(); }
+
 	// the three components of an Eigen vector as the core's plain doubles
 	struct Vec {
 		double v[3];
@@ -75,6 +77,9 @@ void Ip2_ViscElMat_ViscElMat_StickSlipPhys::go(
 	phys->cs                     = nu_s;
 	phys->tangensOfFrictionAngle = mu_s;
 	phys->mu_k                   = mu_k;
+	// (scene: the dispatcher's, or none for an interaction made outside a step: YADE's current)
+	phys->spheres = (isSphere(*Body::byId(interaction->getId1(), scene)) ? 1 : 0)
+	        | (isSphere(*Body::byId(interaction->getId2(), scene)) ? 2 : 0);
 	interaction->phys            = phys;
 }
 
@@ -109,8 +114,6 @@ std::string Law2_ScGeom_StickSlipPhys_StickSlip::takeError()
 }
 
 namespace {
-	bool isSphere(const Body& b) { return b.shape && b.shape->getClassIndex() == Sphere::getClassIndexStatic(); }
-
 	bool finite(const Vector3r& v) { return std::isfinite(static_cast<double>(v[0] + v[1] + v[2])); }
 
 	std::string vec(const Vector3r& v)
@@ -157,20 +160,30 @@ bool Law2_ScGeom_StickSlipPhys_StickSlip::go(shared_ptr<IGeom>& ig, shared_ptr<I
 	// arm reaches midway into the overlap; a wall's (facet's, box's) side is the point of its
 	// surface nearest the sphere's centre. Across a periodic boundary body 2's image moves
 	// with the cell too.
-	const bool sphere1 = isSphere(b1), sphere2 = isSphere(b2);
-	const Real r1 = sphere1 ? static_cast<const Sphere&>(*b1.shape).radius : Real(0);
-	const Real r2 = sphere2 ? static_cast<const Sphere&>(*b2.shape).radius : Real(0);
-	const Real half = 0.5 * delta;
-	Vector3r   a1, a2;
-	if (sphere1) a1 = (r1 - half) * n;
-	else
-		a1 = (s2.pos + shift2 - (r2 - delta) * n) - s1.pos;
-	if (sphere2) a2 = -(r2 - half) * n;
-	else
-		a2 = (s1.pos + (r1 - delta) * n) - (s2.pos + shift2);
-	Vector3r vrel = s1.vel - s2.vel - shiftVel;
-	if (rotation || !sphere1) vrel += s1.angVel.cross(a1);
-	if (rotation || !sphere2) vrel -= s2.angVel.cross(a2);
+	const bool sphere1 = phys.spheres & 1, sphere2 = phys.spheres & 2;
+	Vector3r   a1, a2, vrel;
+	if (sphere1 && sphere2) {
+		// a sphere pair: YADE's contact point is the law's, midway in the overlap on the line of
+		// the centres, so its lever arms and relative velocity are the law's, but for the cell's
+		// shift, which YADE adds where the image's motion is to be subtracted
+		a1 = c1x;
+		a2 = c2x;
+		vrel = rotation ? yadeVelocity : Vector3r(s1.vel - s2.vel + shiftVel);
+		if (periodic) vrel -= 2 * shiftVel;
+	} else {
+		const Real r1 = sphere1 ? static_cast<const Sphere&>(*b1.shape).radius : Real(0);
+		const Real r2 = sphere2 ? static_cast<const Sphere&>(*b2.shape).radius : Real(0);
+		const Real half = 0.5 * delta;
+		if (sphere1) a1 = (r1 - half) * n;
+		else
+			a1 = (s2.pos + shift2 - (r2 - delta) * n) - s1.pos;
+		if (sphere2) a2 = -(r2 - half) * n;
+		else
+			a2 = (s1.pos + (r1 - delta) * n) - (s2.pos + shift2);
+		vrel = s1.vel - s2.vel - shiftVel;
+		if (rotation || !sphere1) vrel += s1.angVel.cross(a1);
+		if (rotation || !sphere2) vrel -= s2.angVel.cross(a2);
+	}
 	const Real     vn = n.dot(vrel);
 	const Vector3r Vs = vrel - vn * n; // eq. 6
 
@@ -265,7 +278,10 @@ bool Law2_ScGeom_StickSlipPhys_StickSlip::go(shared_ptr<IGeom>& ig, shared_ptr<I
 	// YADE's ViscEl law gives them, the law's about the lever arms
 	addForce(id1, F - phys.normalForce, scene);
 	addForce(id2, phys.normalForce - F, scene);
-	if (rotation) {
+	if (rotation && sphere1 && sphere2) { // (the same lever arms: one cross product a body)
+		addTorque(id1, c1x.cross(F - phys.normalForce), scene);
+		addTorque(id2, c2x.cross(phys.normalForce - F), scene);
+	} else if (rotation) {
 		addTorque(id1, -c1x.cross(phys.normalForce) + a1.cross(F), scene);
 		addTorque(id2, c2x.cross(phys.normalForce) - a2.cross(F), scene);
 	} else {

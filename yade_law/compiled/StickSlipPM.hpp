@@ -34,7 +34,8 @@ public:
 		((Real,mu_k,NaN,,"Kinetic friction coefficient: after a slip the force is Fmin = (2 mu_k - mu_s) Fn (eq. 8)."))
 		((Vector3r,spring,Vector3r::Zero(),,"The tangential spring D (eq. 7): the elongation whose force -Ks D acts on body 1."))
 		((bool,slipped,false,,"The contact slipped in the last step."))
-		((long,slips,0,,"Steps in which the contact slipped since it was made.")),
+		((long,slips,0,,"Steps in which the contact slipped since it was made."))
+		((int,spheres,0,Attr::readonly,"Which bodies are spheres: 1 body 1, 2 body 2, 3 both (set when the contact is made).")),
 		createIndex();
 	);
 	// clang-format on
