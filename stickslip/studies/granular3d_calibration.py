@@ -80,7 +80,7 @@ def measured(cov):
 
 
 def _cuts(r, name):
-    return " ".join(f"{e}: {w}" for (n, e), w in r.cut.items() if n == name)
+    return " ".join(f"{e}: {' and '.join(w)}" for (n, e), w in r.cut.items() if n == name)
 
 
 def coverage(pts, method="auto", surf=None, widenings=(1.0,)):
