@@ -261,7 +261,7 @@ def cmd_run(args):
 
 def cmd_precision(args):
     from . import kinds
-    from .studies.precision import DEFAULT_FACTORS, ladder, run_precision
+    from .studies.precision import DEFAULT_FACTORS, ladder, run_precision, warned_line
     from .runner import prepare_output
 
     sc = scene_mod.load(args.scene)  # validate first: a bad scene is a one-line error
@@ -283,6 +283,7 @@ def cmd_precision(args):
                                      timings=tuple(args.slip_timings))
     for (eng, timing, measure), p in sorted(orders.items()):
         print(f"{eng:9s} {timing:6s} {measure:18s} convergence order {p:.2f}")
+    print(warned_line(csv_path))
     print(f"wrote {csv_path} and the diagrams in {out}")
     return 0
 
