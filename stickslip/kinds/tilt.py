@@ -139,8 +139,8 @@ def figures(out, runs):
         z = df["t"] >= t_stop - 0.005
         b.plot(df["t"][z], df[f"{c}_fs"][z], **plotstyle.line(eng, timing), lw=0.7, label=plotstyle.label(eng, timing))
     ax2 = a.twinx()
-    ax2.plot(df["t"], np.tan(angle), "r-", lw=0.8)
-    ax2.set_ylabel("tan β", color="r")
+    ax2.plot(df["t"], np.tan(angle), "k-", lw=0.8)  # (black: the timings' colours are the runs')
+    ax2.set_ylabel("tan β (black)")
     a.set_xlabel("t (s)")
     a.set_ylabel("friction force (N/m)")
     a.legend(loc="upper left")

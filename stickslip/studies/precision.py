@@ -148,5 +148,5 @@ def warned_line(csv_path):
     n, m = warned(csv_path)
     return (f"{n} of the ladder's {m} runs warn (column `warnings` of {Path(csv_path).name}; each run's text in its "
             "summary.json): at its coarse steps the step timing under-resolves the stick phase, or an impact spans "
-            "fewer steps than an accurate collision needs. Those steps are chosen to show what the time step costs; "
-            "the warnings are the effect measured." if n else f"None of the ladder's {m} runs warns.")
+            "fewer steps than an accurate collision needs: those steps are chosen on purpose, to show what the time "
+            "step costs." if n else f"None of the ladder's {m} runs warns.")
