@@ -5,7 +5,7 @@
    (pair_gran_hooke_stickslip.cpp; lammps_api.h says where the two APIs differ). The wall
    fixes are not part of it: on these versions `fix wall/gran granular ... tangential
    stick_slip` (lammps_plugin/granular/) gives the law on walls (lammps_plugin/README.md,
-   "On LAMMPS 2023 and later"). Built by lammps_plugin/CMakeLists.txt with LAMMPS_2025_DIR. */
+   "On LAMMPS built from source"). Built by lammps_plugin/CMakeLists.txt with LAMMPS_2025_DIR. */
 
 #include "pair_gran_hooke_stickslip.h"
 #include "stickslip_version.h"

@@ -4,8 +4,8 @@
 run -> runner.py, report -> report.py, bench -> bench/table.py, precision, thresholds,
 drum-study and drum-engines -> studies/precision.py, thresholds.py, drum_study.py,
 drum_engines.py; study-3d and calibrate -> studies/granular3d.py, calibrate.py. Bad arguments or a bad scene: one line on
-stderr, exit status 2; an engine that fails, a file that cannot be written, or a fault of
-ours: one line, exit status 1 (STICKSLIP_TRACEBACK=1 shows the traceback of a fault).
+stderr, exit status 2; an engine that fails, a file that cannot be written, or an internal
+fault: one line, exit status 1 (STICKSLIP_TRACEBACK=1 shows the traceback of a fault).
 """
 from __future__ import annotations
 
@@ -173,7 +173,14 @@ def build_parser():
     g3.add_argument("--quiet", action="store_true", help="no progress bar")
 
     cal = sub.add_parser("calibrate", help="mu_s and mu_k for target angles of a bed of spheres, from the measured "
-                                           "map of study-3d (docs/granular-3d.md)")
+                                           "map of study-3d (docs/granular-3d.md)",
+                         description="Answers mu_s and mu_k, the stick-slip law's static and kinetic friction "
+                                     "coefficients, for a material of spheres, each with its 68 % range, read on the "
+                                     "map stickslip study-3d measured (docs/granular-3d.md, 'A calibration you can "
+                                     "apply'). It needs at least two targets measured on the material: two or more "
+                                     "of the options below (its angles on an incline and a heap, a sheared layer's "
+                                     "figures) or a --measurements file. An end of a range that the map's edge or one "
+                                     "of the law's bounds cuts is said to be one.")
     shear = "needs a map that measured it"
     for name, what in (("theta_start", "angle at which a bed starts to flow, deg"),
                        ("theta_stop", "angle at which a flowing bed stops on an incline held still, deg (read on an "
@@ -193,8 +200,9 @@ def build_parser():
     cal.add_argument("--interpolation", choices=("auto", "linear", "quadratic"), default="auto",
                      help="the map's interpolation (default auto: the one of smaller leave-one-out error)")
     cal.add_argument("--region-png", type=Path, help="draw the answer's chi2 region on the map (PNG)")
-    cal.add_argument("--rolling", type=float, default=0.0, help="rolling resistance coefficient (epsd2) of the "
-                                                                 "material (default: 0)")
+    cal.add_argument("--rolling", type=float, default=0.0, help="rolling resistance coefficient (LIGGGHTS' epsd2) "
+                                                                 "of the material: one the map measured, 0 or 0.1 on "
+                                                                 "the committed map (default: 0)")
     cal.add_argument("--map", type=Path, help="the measured map, points.csv (default: docs/granular-3d/points.csv)")
     out = cal.add_mutually_exclusive_group()
     out.add_argument("--details", action="store_true", help="also the statistics behind the answer")
@@ -230,7 +238,7 @@ def main(argv=None):
     except KeyboardInterrupt:
         sys.stderr.write("stickslip: interrupted\n")
         return 130
-    except Exception as e:  # a fault of ours: one line for the user, the traceback on request
+    except Exception as e:  # an internal fault: one line for the user, the traceback on request
         if os.environ.get("STICKSLIP_TRACEBACK"):
             raise
         sys.stderr.write(f"stickslip: error: internal error ({type(e).__name__}: {' '.join(str(e).split())[:200]}); "
@@ -253,7 +261,7 @@ def cmd_run(args):
 
 def cmd_precision(args):
     from . import kinds
-    from .studies.precision import DEFAULT_FACTORS, ladder, run_precision
+    from .studies.precision import DEFAULT_FACTORS, ladder, run_precision, warned_line
     from .runner import prepare_output
 
     sc = scene_mod.load(args.scene)  # validate first: a bad scene is a one-line error
@@ -275,6 +283,7 @@ def cmd_precision(args):
                                      timings=tuple(args.slip_timings))
     for (eng, timing, measure), p in sorted(orders.items()):
         print(f"{eng:9s} {timing:6s} {measure:18s} convergence order {p:.2f}")
+    print(warned_line(csv_path))
     print(f"wrote {csv_path} and the diagrams in {out}")
     return 0
 

@@ -6,9 +6,19 @@ ENGINE_LINES = {"pyref": "-", "liggghts": "--", "yade": ":", "yade_cpp": (0, (3,
                 "lammps_granular": (0, (5, 2, 1, 2, 1, 2)), "deme": (0, (1, 3))}
 
 
-def line(engine):
-    """An engine's line in the figures that overlay engines (keyword arguments of plot)."""
-    return {"linestyle": ENGINE_LINES[engine]}
+TIMING_COLOURS = {"step": "C0", "exact": "C3"}
+
+
+def line(engine, timing=None):
+    """An engine's line in the figures that overlay engines (keyword arguments of plot); with a
+    slip timing, its colour too (a figure that shows both timings)."""
+    return {"linestyle": ENGINE_LINES[engine], **({"color": TIMING_COLOURS[timing]} if timing else {})}
+
+
+def label(engine, timing, law=None):
+    """A run's legend entry: what it is, engine and slip timing (and the law, where a figure
+    shows several): "pyref, step timing", "coulomb: pyref, step timing"."""
+    return f"{law + ': ' if law else ''}{engine}, {timing} timing"
 
 
 def pyplot():

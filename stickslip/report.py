@@ -40,8 +40,9 @@ def build_report(out: Path, engines=None, progress=True, studies=True, cpu_log=N
                     if law != "stick_slip" and eng != "pyref":
                         continue  # the engines ship only the stick-slip law
                     keys.append((case, law, timing, eng))
+                    # (the runs' warnings go into report.md's tables, not to the console)
                     tasks.append(runner.task(case, eng, out / "runs" / _label(case, law, timing, base) / eng,
-                                             law=law, slip_timing=timing))
+                                             warn=False, law=law, slip_timing=timing))
     study_tasks, finish_studies = study_plan(out, CASES, engines) if studies else ([], None)
     unique, results_of = runner.once(tasks + study_tasks)
     got = results_of(parallel.run_all(unique, "report", progress, cpu_log))
@@ -94,10 +95,10 @@ def _markdown(results, engines, skipped, figs):
     lines.append("Engines: " + ", ".join(engines))
     for e, why in skipped.items():
         lines.append(f"- {e} not run: {why}")
-    lines += ["", "## The paper's statements beside ours", "",
-              "Every quantitative or checkable statement of the paper's section 3, our value on each engine (and "
-              "slip timing, for case 3: the paper ties its speed effect to the time step) and a verdict. How we "
-              "read each statement (its tolerance and why) is in the third column.", ""]
+    lines += ["", "## The paper's statements beside the runs", "",
+              "Every quantitative or checkable statement of the paper's section 3, the value each engine gives (and "
+              "each slip timing, for case 3: the paper ties its speed effect to the time step) and a verdict. How "
+              "each statement is read (its tolerance and why) is in the third column.", ""]
     for case in CASES:
         lines += _paper_table(case, results[case])
     for case in CASES:
@@ -110,7 +111,8 @@ def _markdown(results, engines, skipped, figs):
             for key, text in kinds.get(sc.analysis["kind"]).claims(sc):
                 vals = [fmt(results[case][(law, timing, e)][1].get(key)) for e in present]
                 lines.append(f"| {cell(text)} | " + " | ".join(vals) + " |")
-            # one line per distinct warning, naming the engines it came from
+            # one line per distinct warning, naming the engines it came from: the report's scenes
+            # are the paper's, so their warnings are stated here, where the figures are
             notes = {}
             for e in present:
                 for n in results[case][(law, timing, e)][1].get("notes", []):
@@ -141,7 +143,7 @@ def _paper_table(case, runs):
                      key=lambda c: (c[0] != "step", adapters.ENGINES.index(c[1]) if c[1] in adapters.ENGINES else 9))
     timed = len({t for t, _ in columns}) > 1
     head = [f"{e} ({t})" if timed else e for t, e in columns]
-    lines = [f"### {case}", "", "| § | the paper says | how we check it | " + " | ".join(head) + " | verdict | why |",
+    lines = [f"### {case}", "", "| § | the paper says | how it is checked | " + " | ".join(head) + " | verdict | why |",
              "|---|---|---|" + "---|" * len(head) + "---|---|"]
     for section, text, how, values, verdicts, why in rows:
         verdict = "; ".join(f"{v} ({t})" if timed else v for t, v in sorted(verdicts.items(), key=lambda kv: kv[0] != "step"))

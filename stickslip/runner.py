@@ -50,11 +50,13 @@ def prepare_output(out_dir) -> Path:
     return out
 
 
-def run_scene(scene, engine, out_dir, progress=True, ranks=1, write_timeseries=True):
+def run_scene(scene, engine, out_dir, progress=True, ranks=1, write_timeseries=True, warn=True):
     """Run a validated scene on an engine; write timeseries.csv and summary.json into
     out_dir; returns (summary, timeseries). ranks > 1: MPI processes (MPI_ENGINES only).
     write_timeseries=False: for a study that keeps only a reduction of the series (a long
-    drum run's CSV is gigabytes and takes longer to write than to reduce)."""
+    drum run's CSV is gigabytes and takes longer to write than to reduce). The run's
+    warnings (summary["notes"]) go to stderr too, but with warn=False: a study that chose
+    the run on purpose (a coarse step of a time-step ladder) says once what they mean."""
     adapter = adapters.get(engine)
     if ranks > 1 and engine not in MPI_ENGINES:
         raise SceneError(f"--ranks {ranks}: only {', '.join(MPI_ENGINES)} run on several MPI processes "
@@ -93,7 +95,7 @@ def run_scene(scene, engine, out_dir, progress=True, ranks=1, write_timeseries=T
     notes = list(result.notes) + scene_mod.accuracy_warnings(scene) + analysis.warnings(scene, summary)
     summary["notes"] = notes
     _write(out_dir / "summary.json", lambda p: p.write_text(json.dumps(summary, indent=2, default=_plain) + "\n"))
-    for note in notes:
+    for note in notes if warn else ():
         sys.stderr.write(f"stickslip: warning: {note}\n")
     return summary, df
 
@@ -135,16 +137,18 @@ def cost(scene, engine, steps=None) -> float:
     return _START[engine] + steps * (_STEP[engine] + _PER_OBJECT[engine] * (len(scene.grains) + len(scene.walls)))
 
 
-def run_named(scene_name, engine, out_dir, overrides):
+def run_named(scene_name, engine, out_dir, overrides, warn=True):
     """A task for stickslip/parallel.py: load a scene with overrides and run it quietly;
-    returns (scene, summary, timeseries)."""
+    returns (scene, summary, timeseries). warn: run_scene's."""
     sc = scene_load(scene_name, **overrides)
-    return (sc, *run_scene(sc, engine, out_dir, progress=False))
+    return (sc, *run_scene(sc, engine, out_dir, progress=False, warn=warn))
 
 
-def task(scene_name, engine, out_dir, **overrides):
-    """(cost, function, args) of one run, for parallel.run_all."""
-    return (cost(scene_load(scene_name, **overrides), engine), run_named, (scene_name, engine, out_dir, overrides))
+def task(scene_name, engine, out_dir, warn=True, **overrides):
+    """(cost, function, args) of one run, for parallel.run_all. warn=False: the run's
+    warnings stay in its summary (a study that chose the run says what they mean)."""
+    return (cost(scene_load(scene_name, **overrides), engine), run_named,
+            (scene_name, engine, out_dir, overrides, warn))
 
 
 def once(tasks):

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pandas as pd
@@ -112,14 +113,44 @@ def test_a_file_of_repeats_gives_the_mean_and_its_standard_error(tmp_path, capsy
 
 
 @pytest.mark.parametrize("lo, hi, shown", [(0.505, 0.645, "0.58 (0.50 to 0.65"), (0.503, 0.893, "0.58 (0.50 to 0.90"),
-                                           (0.5675, 0.5925, "0.580 (0.567 to 0.593"), (0.35, 1.0, "0.6 (0.3 to 1.0"),
-                                           (0.58, 0.58, "0.580 (0.580 to 0.580")])
+                                           (0.5675, 0.5925, "0.580 (0.567 to 0.593"), (0.35, 0.85, "0.6 (0.3 to 0.9"),
+                                           (0.58, 0.58, "0.580 (0.580 to 0.580"), (0.35, 0.93, "0.6 (0.3 to 0.93"),
+                                           (0.21, 0.85, "0.6 (0.21 to 0.9")])
 def test_the_answer_has_the_digits_its_range_allows(lo, hi, shown):
     """The value and its range to the decimal of the range's half-width's first significant
     digit (two digits where it is 1), from 1 to 3 decimals (the grid's step is 0.0025); the
-    range rounded outwards, so that the printed range holds the computed one."""
-    c = {"value": 0.58, "range": [lo, hi], "cut": {"low": None, "high": None}}
+    range rounded outwards, so that the printed range holds the computed one, but never onto
+    the map's extent (here mu_s 0.2 to 1.0), which would read as its edge: 0.93 stays 0.93,
+    0.21 stays 0.21."""
+    c = {"value": 0.58, "range": [lo, hi], "cut": {"low": None, "high": None}, "extent": [0.2, 1.0]}
     assert calibrate._coefficient_line("mu_s", c) == f"mu_s = {shown})"
+
+
+# Ranges calibrate gave on the committed map, as (low, high), the edges cutting each end, the map's
+# extent: 24.5/21.5 deg's mu_s and 25.8/22.6 deg's mu_k and mu_s (both ends cut there).
+ANSWERED = [((0.3475, 0.93), (("mu_k = mu_s",), None), (0.2, 1.0)),
+            ((0.4925, 0.94), (("mu_k = mu_s / 2",), None), (0.1, 1.0)),
+            ((0.7475, 1.0), (("mu_k = mu_s",), ("map",)), (0.2, 1.0)),
+            ((0.2, 0.4975), (("map", "mu_k = mu_s"), ("mu_k = mu_s / 2",)), (0.2, 1.0))]
+
+
+@pytest.mark.parametrize("computed, cuts, extent", ANSWERED)
+def test_the_printed_range_holds_the_computed_one_and_names_only_real_edges(computed, cuts, extent):
+    """Each printed end lies outside or on the computed range; an end named an edge is printed
+    as the computed end itself (the edge's value there), with every edge that cuts it named;
+    an uncut end is never printed on the map's extent (which would read as its edge)."""
+    c = {"value": sum(computed) / 2, "range": list(computed), "cut": dict(zip(("low", "high"), cuts)),
+         "extent": list(extent)}
+    line = calibrate._coefficient_line("mu_k", c)
+    m = re.match(r"mu_k = [\d.]+ \(([\d.]+) to ([\d.]+)((?:; [\d.]+ is [^;]+, not an uncertainty)*)\)$", line)
+    assert m, line
+    lo, hi = float(m.group(1)), float(m.group(2))
+    assert lo <= computed[0] and hi >= computed[1], line
+    named = re.findall(r"; ([\d.]+) is ([^;]+), not an uncertainty", m.group(3))
+    assert [float(v) for v, _ in named] == [v for v, cut in zip(computed, cuts) if cut], line
+    assert [w for _, w in named] == [" and ".join(calibrate.EDGE[e] for e in cut) for cut in cuts if cut], line
+    for v, cut in zip((lo, hi), cuts):
+        assert cut or extent[0] < v < extent[1], line
 
 
 def test_the_answer_comes_first_and_only_the_targets_given_are_shown(synthetic, tmp_path, capsys):
@@ -129,8 +160,11 @@ def test_the_answer_comes_first_and_only_the_targets_given_are_shown(synthetic, 
     assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--theta-stop-se", "0.3",
                  "--map", str(path)]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0].startswith("mu_s = 0.70") and lines[1].startswith("mu_k = 0.50") and len(lines) == 3
-    assert lines[2].startswith("each range: where its coefficient lies with 68 % confidence, the other left free")
+    # the synthetic map has no leave_pair_out.csv beside it: the first line says the ranges are not widened
+    assert lines[0].startswith(f"note: no leave_pair_out.csv beside --map {path}: the ranges are not widened")
+    assert lines[1].startswith("mu_s = 0.70") and lines[2].startswith("mu_k = 0.50") and len(lines) == 4
+    assert lines[3].startswith("each range: where its coefficient lies with 68 % confidence, the other left free")
+    assert lines[3].endswith("the targets' errors; not widened (first line)); --details: the statistics")
     assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--map", str(path), "--details"]) == 0
     out = capsys.readouterr().out
     assert "the map at the answer: theta_start 34.0 +- " in out and "theta_heap" not in out
@@ -150,7 +184,7 @@ def test_the_range_cut_by_the_maps_edge_is_called_a_bound(tmp_path, capsys):
     assert "edge:" not in out  # the answer, 0.79, is inside; only its range reaches the edge
     assert (tmp_path / "r.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f"wrote {tmp_path / 'r.png'}" in out
     a = _answer(capsys, "--theta-start", "32", "--theta-stop", "26.8", "--theta-stop-se", "0.5", "--map", str(path))
-    assert "mu_k = mu_s" in (a["mu_k"]["cut"]["high"], a["mu_s"]["cut"]["low"])
+    assert "mu_k = mu_s" in (a["mu_k"]["cut"]["high"] or []) + (a["mu_s"]["cut"]["low"] or [])
 
 
 def test_an_answer_on_the_maps_edge_or_on_a_laws_bound_is_told(tmp_path, capsys):
@@ -229,6 +263,19 @@ def _broken(rows, column, value):
     (lambda p: p.assign(rolling=0.2), "column rolling has no map rows at --rolling 0: it was measured at 0.2 only"),
     (lambda p: p.assign(engine="lammps"), "no rows with engine 'liggghts' and group 'sweep' or 'shear'"),
     (None, "cannot be read as CSV"),
+    # a NaN written in a map cell, and an empty one where the row's kind measures the target
+    (lambda p: _broken(p, "theta_stop_mean", "nan"), "column theta_stop_mean, line 4: 'nan': expected a finite number"),
+    (lambda p: _broken(p.assign(theta_start_n=3), "theta_start_n", "NaN"), "column theta_start_n, line 4: 'NaN': expected a finite number"),
+    (lambda p: _broken(p, "theta_start_mean", np.nan), "column theta_start_mean, line 4: empty: expected a finite "
+                                                        "number (a map row of kind incline measures theta_start)"),
+    # a column renamed: its statistics without their mean, or a name study-3d does not write
+    (lambda p: p.rename(columns={"theta_stop_mean": "theta_stop_avg"}), "column 'theta_stop_avg' is not a column of "
+                                                                         "a map"),
+    (lambda p: p.drop(columns="theta_stop_mean"), "column theta_stop_se has no theta_stop_mean beside it"),
+    # a row twice, and one map point twice (another material's name, the same point)
+    (lambda p: pd.concat([p, p.iloc[[2]]]), "line 18 repeats line 4: each row once"),
+    (lambda p: pd.concat([p, p.iloc[[2]].assign(theta_start_mean=40.0)]), "lines 4 and 18: two map points of kind "
+                                                                          "incline at mu_s 0.35, mu_k 0.35"),
 ])
 def test_a_malformed_map_is_one_line_naming_the_file_and_column(tmp_path, capsys, change, message):
     """A map that is not study-3d's points.csv (a column missing or of the wrong type, an empty
@@ -371,7 +418,7 @@ def test_targets_that_disagree_on_the_map_are_told(tmp_path, capsys):
     out = capsys.readouterr().out
     line = next(t for t in out.splitlines() if t.startswith("agreement:"))
     chi2 = float(line.split("least chi2 ")[1].split()[0])
-    warning = out.splitlines()[3]  # the plain answer's: after mu_s, mu_k and the ranges' line
+    warning = out.splitlines()[4]  # the plain answer's: after the note (no widening file), mu_s, mu_k, the ranges
     assert 4.0 < chi2 < 9.0 and warning.startswith("warning: the targets do not agree with each other on the map"), out
 
 
@@ -458,3 +505,46 @@ def test_calibrate_widens_its_ranges_by_the_maps_own_measure(tmp_path, capsys):
     assert half(wide) == pytest.approx(2 * half(plain), abs=calibrate_fit.GRID)
     assert main(["calibrate", *given]) == 0
     assert "widened by 2.00 as measured on the map's own points" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda r: r.drop(columns="mu_k_ratio"), "no column 'mu_k_ratio': expected leave_pair_out.csv of stickslip "
+                                             "study-3d"),
+    (lambda r: _broken(r, "mu_s_ratio", "wide"), "column mu_s_ratio, line 4: 'wide': expected a number"),
+    (lambda r: _broken(r, "rolling", np.nan), "column rolling, line 4: empty: expected a number"),
+])
+def test_a_malformed_widening_file_is_one_line_naming_it(tmp_path, capsys, change, message):
+    """leave_pair_out.csv beside the map, not as study-3d writes it: one line naming the file, the
+    column and the line, status 2, no answer."""
+    path = _precise_map(tmp_path)
+    change(_lpo_rows([4.0] * 10)).to_csv(tmp_path / "leave_pair_out.csv", index=False)
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--map", str(path)]) == 2
+    got = capsys.readouterr()
+    assert got.out == "" and got.err.startswith(f"stickslip: error: {tmp_path / 'leave_pair_out.csv'} (beside --map)")
+    assert message in got.err and got.err.count("\n") == 1, got.err
+
+
+def test_a_widening_file_without_ranges_at_the_rolling_asked_is_said_first(tmp_path, capsys):
+    """leave_pair_out.csv beside the map whose ranges are all at another rolling resistance:
+    the answer's ranges are not widened, and the first line says so."""
+    path = _precise_map(tmp_path)
+    _lpo_rows([4.0] * 10).assign(rolling=0.1).to_csv(tmp_path / "leave_pair_out.csv", index=False)
+    assert main(["calibrate", "--theta-start", "34", "--theta-stop", "21", "--map", str(path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == (f"note: leave_pair_out.csv beside --map {path} has no ranges uncut by an edge at --rolling 0: "
+                        "the ranges are not widened by the map's own measure (f = 1), so they may hold the truth less "
+                        "often than 68 %") and lines[1].startswith("mu_s = 0.70")
+    a = _answer(capsys, "--theta-start", "34", "--theta-stop", "21", "--map", str(path))
+    assert a["ranges"]["widened_by"] == 1.0 and a["ranges"]["note"] == lines[0]
+
+
+def test_calibrates_help_says_what_it_answers_and_what_it_needs(capsys):
+    """`calibrate --help` names what it answers (mu_s and mu_k), that it needs two targets, and
+    the rolling resistances the committed map measured (the values --rolling takes)."""
+    with pytest.raises(SystemExit):
+        main(["calibrate", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    pts = calibrate_map.read_points(calibrate.DOCS / "points.csv")
+    rolls = " or ".join(f"{r:g}" for r in sorted(pts[calibrate_map.on_map(pts)]["rolling"].unique()))
+    assert "Answers mu_s and mu_k" in text and "at least two targets" in text, text
+    assert f"{rolls} on the committed map" in text, (rolls, text)

@@ -9,6 +9,7 @@ every example input the docs call runnable runs on its engine (short: a few thou
 The YADE example (yade_law/example_drag.py) is run by tests/test_yade_law.py; `stickslip run`
 by tests/test_cli_studies.py.
 """
+import argparse
 import json
 import os
 import re
@@ -252,6 +253,19 @@ def test_machine_paths_are_told_from_system_ones():
     assert machine_paths("/usr/share/lammps/examples /etc/apt/x /proc/PID/stat >/dev/null #!/usr/bin/env "
                          "/path/to/build https://github.com/a/b lammps/lammps#3022 m/s/x ${TMPDIR:-/tmp}/w "
                          "'*/src/*.h' \"$top\"/download/x") == []
+
+
+# How one machine lent for a while was driven (its output folder's variable, a folder of the
+# bundle beside the checkout, what it carries over, its kind) is no part of a check anyone
+# reruns: a command names its files (BUNDLE, JIT_CACHE, OUT=DIR), not that set-up's.
+LENDING = re.compile(r"OUT=\$OUT\b|(?<![\w/])\.gpu/|\blent\b|device machine|\(carry:|\bone H100\b")
+
+
+def test_no_file_carries_a_lent_machines_setup():
+    this = Path(__file__).relative_to(ROOT).as_posix()  # (its own examples of what is refused)
+    found = [f"{rel}:{text.count(chr(10), 0, m.start()) + 1}: {m.group(0)!r}" for rel, text in text_files()
+             if rel != this for m in LENDING.finditer(text)]
+    assert not found, "\n".join(found)
 
 
 def test_no_file_names_a_machines_folders():
@@ -855,3 +869,235 @@ def test_the_last_profile_is_the_historys_newest():
                           section(page, "### The suite's run time"))
     newest = next(a or b for a, b in profiles)
     assert stated and round(float(stated.group(1))) == round(float(newest)), (stated and stated.group(1), newest)
+
+
+# --- "above" and "below" -----------------------------------------------------------------------
+# A page that sends the reader to another of its sections says which way: "the round trip
+# above", "the core's 21 (below)", "[below](#the-scenes-and-why)". Where the words before
+# "above"/"below" name a heading of the page (its last word of four letters or more, not one of
+# GENERIC), or a link names the heading's anchor, that heading must lie that way.
+DIRECTED = re.compile(r"\b((?:[\w'’-]+\s+){0,3}?[\w'’-]+)\s+\(?(above|below)\b")
+DIRECTED_LINK = re.compile(r"\[(above|below)\]\(#([^)\s]+)\)")
+GENERIC = {"that", "this", "with", "from", "each", "than", "what", "when", "where", "which", "there", "these",
+           "those", "more", "less", "only", "also", "into", "over", "under", "both", "figures", "figure", "table",
+           "tables", "line", "lines", "rows", "text"}
+
+
+def heading_lines(page):
+    """(line number, anchor, words) of each heading of a page below its title (levels 2-6)."""
+    out, seen, inside = [], {}, False
+    for n, line in enumerate(page.read_text().splitlines(), 1):
+        if FENCE.match(line):
+            inside = not inside
+            continue
+        m = re.match(r"^(#{1,6})\s+(.*?)\s*#*\s*$", line)
+        if m and not inside:
+            s = slug(m.group(2))
+            anchor = s if s not in seen else f"{s}-{seen[s]}"
+            seen[s] = seen.get(s, 0) + 1
+            if len(m.group(1)) > 1:
+                out.append((n, anchor, heading_words(m.group(2))))
+    return out
+
+
+def heading_words(text):
+    """The words of a text, lower case, a possessive's "'s" dropped."""
+    return [re.sub(r"['’]s$", "", w) for w in re.findall(r"[\w'’-]+", text.lower())]
+
+
+def direction_findings(page):
+    """Each "above"/"below" of a page that names one of its headings lying the other way."""
+    heads = heading_lines(page)
+    found = []
+    for n, text in prose_lines(page):
+        own = max((h for h, _, _ in heads if h <= n), default=0)  # the section the line is in
+        for m in DIRECTED_LINK.finditer(text):
+            target = [h for h, anchor, _ in heads if anchor == m.group(2)]
+            if target and (target[0] < n) != (m.group(1) == "above"):
+                found.append(f"{shown(page)}:{n}: {m.group(0)!r}: its heading is at line {target[0]}")
+        for m in DIRECTED.finditer(re.sub(r"\]\([^)]*\)", "]", text)):
+            named = [w for w in heading_words(m.group(1)) if len(w) >= 4 and w not in GENERIC]
+            lines = [h for h, _, ws in heads if named and named[-1] in ws and h != own]
+            if lines and not any((h < n) == (m.group(2) == "above") for h in lines):
+                found.append(f"{shown(page)}:{n}: {m.group(0)!r}: its heading is at line {lines[0]}")
+    return found
+
+
+def test_direction_findings_catch_each_kind(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("# P\n\n## The law's core\n\nIts 21 mutants.\n\n## Tables\n\n| the core's 21 (below) |\n"
+                    "the core's 21 (above); the round trip below; [below](#the-laws-core)\n"
+                    "the figures below\n\n## The round trip\n\nText.\n")
+    got = direction_findings(page)
+    assert [f.split(": ", 2)[1] for f in got] == ['"the core\'s 21 (below"', "'[below](#the-laws-core)'"], got
+    assert [f.split(":")[1] for f in got] == ["9", "10"], got
+
+
+def test_above_and_below_point_to_their_headings():
+    found = [f for page in markdown_files() for f in direction_findings(page)]
+    assert not found, "\n".join(found)
+
+
+# --- the command line the pages name ----------------------------------------------------------
+# A `stickslip SUBCOMMAND --option ...` in a page's code (a span or a fenced block) names a
+# subcommand of the parser and options it takes; "stickslip a / b / c" names three.
+COMMAND = re.compile(r"(?:(?<=[\s`(])|^|(?<=bin/))(?<!from )stickslip ([a-z][a-z0-9-]*(?: / [a-z][a-z0-9_-]*)*)"
+                     r"([^#`]*)")
+
+
+def commands_named(page):
+    """(line number, subcommand, its options) of each `stickslip` command in a page's code."""
+    out, inside = [], False
+    for n, line in enumerate(page.read_text().splitlines(), 1):
+        if FENCE.match(line):
+            inside = not inside
+            continue
+        for part in [line] if inside else re.findall(r"`([^`]*)`", line):
+            for m in COMMAND.finditer(part):
+                names = m.group(1).split(" / ")
+                options = re.findall(r"(?<![\w-])(--[a-z][a-z0-9-]*)", m.group(2)) if len(names) == 1 else []
+                out += [(n, name, options) for name in names]
+    return out
+
+
+def command_findings(pages, parser):
+    """Each subcommand a page names that the parser has not, and each option its subcommand
+    does not take."""
+    subs = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+    found = []
+    for page in pages:
+        for n, name, options in commands_named(page):
+            if name not in subs:
+                found.append(f"{shown(page)}:{n}: `stickslip {name}`: no such subcommand ({', '.join(subs)})")
+                continue
+            known = {o for a in subs[name]._actions for o in a.option_strings}
+            found += [f"{shown(page)}:{n}: `stickslip {name} {o}`: no such option" for o in options if o not in known]
+    return found
+
+
+def test_command_findings_catch_each_kind(tmp_path):
+    from stickslip.cli import build_parser
+
+    page = tmp_path / "p.md"
+    page.write_text("`stickslip run drag --engine lammps --speed 2`\n```sh\n.venv/bin/stickslip friction-speed\n"
+                    "stickslip report / precision / friction_speed  # three\n```\nthe stickslip package, "
+                    "`from stickslip import scene`\n")
+    got = [f.split(": ", 1)[1].split(":")[0] for f in command_findings([page], build_parser())]
+    assert got == ["`stickslip run --speed`", "`stickslip friction-speed`", "`stickslip friction_speed`"], got
+
+
+def test_the_commands_the_pages_name_are_the_parsers():
+    from stickslip.cli import build_parser
+
+    pages = markdown_files()
+    assert sum(len(commands_named(p)) for p in pages) > 50
+    found = command_findings(pages, build_parser())
+    assert not found, "\n".join(found)
+
+
+# --- sections named by other files ------------------------------------------------------------
+# A file that sends its reader to a section of a page by name (`docs/law.md "Energy"`, `(README,
+# "The test suite")`, `lammps_plugin/README.md, "Restarts"`) names a heading, or a bold label,
+# that the page has. The page's path is relative to the file's folder or one above it.
+SECTION_REF = re.compile(r"\b((?:[\w.-]+/)*[\w.-]+\.md|README)(?:'s)?(?:,\s*(?:History,\s*)?|\s+)\"([^\"]{3,80})\"")
+
+
+def section_names(page):
+    """The text of a page's headings and bold labels, lower case, markup dropped."""
+    text = page.read_text()
+    names = re.findall(r"^#{1,6}\s+(.*?)\s*$", text, flags=re.M) + re.findall(r"\*\*([^*]+)\*\*", text)
+    return [re.sub(r"[`*]", "", n).lower() for n in names]
+
+
+def section_reference_findings(files):
+    """Each reference to a section of a page (in (path, text) pairs) whose page has no such
+    section, or that names no page."""
+    found = []
+    for rel, text in files:
+        # a reference may wrap over lines, also in code comments ('#', '//', '*' leading the line)
+        flat = re.sub(r"[ \t]*\n[ \t]*(?:#|//|\*(?!\*))?[ \t]*", " ", text)
+        for m in SECTION_REF.finditer(flat):
+            name = "README.md" if m.group(1) == "README" else m.group(1)
+            here = ROOT / rel
+            pages = [p / name for p in (here.parent, *here.parents) if (p / name).is_file() and p.is_relative_to(ROOT)]
+            if not pages:
+                found.append(f"{rel}: {m.group(0)!r}: no page {name}")
+            elif not any(m.group(2).lower() in s for s in section_names(pages[0])):
+                found.append(f"{rel}: {m.group(0)!r}: {shown(pages[0])} has no such section")
+    return found
+
+
+def test_section_reference_findings_catch_each_kind():
+    files = [("pyproject.toml", '# the mutation run (README, "The test suite"): pip install\n'),
+             ("tools/x.py", '# (docs/law.md "Energy"), (docs/law.md, "Exact slip\n# timing"), (docs/nope.md "Abc")\n'),
+             ("docs/testing.md", 'docs/granular-3d.md, "The scenes and why"; docs/testing.md\'s "last profile"\n')]
+    got = [f.split(": ", 2)[2] for f in section_reference_findings(files)]
+    assert got == ["README.md has no such section", "no page docs/nope.md"], got
+
+
+def test_every_section_a_file_names_is_its_pages():
+    this = Path(__file__).relative_to(ROOT).as_posix()  # (its own examples)
+    found = section_reference_findings([(rel, text) for rel, text in text_files() if rel != this])
+    assert not found, "\n".join(found)
+
+
+# --- requirements and calls the pages state ------------------------------------------------------
+
+def test_the_readmes_requirements_are_pyprojects():
+    """The README's pyref row names the Python version and the packages pyproject.toml
+    requires, all of them and no other."""
+    import tomllib
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    row = next(ln for ln in (ROOT / "README.md").read_text().splitlines() if ln.startswith("| pyref |"))
+    stated = row.split("|")[2]
+    python = re.search(r"Python ≥ ([\d.]+)", stated)
+    assert python and project["requires-python"] == f">={python.group(1)}", (stated, project["requires-python"])
+    wanted = {re.split(r"[<>=\[ ]", d)[0] for d in project["dependencies"]}
+    named = set(re.findall(r"\b(numpy|scipy|pandas|matplotlib|tqdm|[a-z][a-z0-9_-]+)\b", stated.split("with", 1)[1]
+                           .split("(")[0]))
+    assert named == wanted, (named, wanted)
+
+
+def test_the_pages_make_the_deme_solver_as_the_adapter_does():
+    """Every `deme.DEMSolver(...)` a page shows is the call the adapter makes first
+    (stickslip/adapters/deme.py new_solver: DEM-Engine 3 takes a list of devices)."""
+    first = re.search(r"deme\.DEMSolver\(([^)]*)\)", (ROOT / "stickslip/adapters/deme.py").read_text()).group(1)
+    calls = [(shown(p), m.group(1)) for p in markdown_files() for m in re.finditer(r"deme\.DEMSolver\(([^)]*)\)",
+                                                                                p.read_text())]
+    assert first == "[0]" and calls and all(args == first for _, args in calls), calls
+
+
+def test_the_lammps_examples_set_the_law_as_their_page_says():
+    """lammps_plugin/examples/README.md names the inputs that set the law's keywords: each of
+    them sets those words, and every other input names the sub-model (`tangential
+    stick_slip`)."""
+    page = (ROOT / "lammps_plugin/examples/README.md").read_text()
+    m = re.search(r"((?:`in\.\w+`(?:, | and )?)+) set the law as docs/law\.md states it: `([^`]+)`", " ".join(page.split()))
+    assert m, "the sentence naming the inputs that set the law"
+    named, words = re.findall(r"`(in\.\w+)`", m.group(1)), m.group(2).split()
+    for script in sorted((ROOT / "lammps_plugin/examples").glob("in.*")):
+        text = " ".join(script.read_text().split())
+        if script.name in named:
+            assert " ".join(words) in text, (script.name, words)
+        else:
+            assert "tangential stick_slip" in text, script.name
+    assert named, m.group(0)
+
+
+def test_the_liggghts_page_reads_the_record_where_the_adapter_does():
+    """The LIGGGHTS page's columns of `compute pair/gran/local id history` (3 columns of `id`,
+    then the history) and of a wall's per-atom history are the layout the adapter reads
+    (stickslip/adapters/liggghts.py: D in history values 1-3, then Fn, F_s, the slip count),
+    wherever the page states them."""
+    text = " ".join((ROOT / "liggghts_plugin/doc/tangential_model_stick_slip.md").read_text().split())
+    a = liggghts_adapter
+    pair = {"D": (4, 6), "Fn": (3 + a.RECORD_FN,) * 2, "F_s": (3 + a.RECORD_FS, 3 + a.RECORD_FS + 2),
+            "slip count": (3 + a.RECORD_NSLIP,) * 2}
+    listed = re.search(r"then the history: 4-6 `D`, (\d+) `Fn`, (\d+)-(\d+) `F_s`, (\d+) slip count", text)
+    assert listed and tuple(map(int, listed.groups())) == (pair["Fn"][0], *pair["F_s"], pair["slip count"][0])
+    wall = re.search(r"`f_history_<wallfixID>\[1\.\.3\]` = `D`, `\[(\d+)\]` = `Fn`, `\[(\d+)\.\.(\d+)\]` = `F_s`, "
+                     r"`\[(\d+)\]` = slip count", text)
+    assert wall and tuple(map(int, wall.groups())) == (a.RECORD_FN, a.RECORD_FS, a.RECORD_FS + 2, a.RECORD_NSLIP)
+    for m in re.finditer(r"columns (\d+)-(\d+) of `compute pair/gran/local([^`]*)`", text):
+        assert " id " in m.group(3) + " " and (int(m.group(1)), int(m.group(2))) == pair["D"], m.group(0)

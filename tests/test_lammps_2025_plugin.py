@@ -14,8 +14,8 @@ takes, from the source Debian's LAMMPS builds (lammps_plugin/lammps_api.h).
 - a bad keyword stops the run with one ERROR line.
 
 The wall fixes are not in the plugin: on LAMMPS 2023 and later `fix wall/gran granular ...
-tangential stick_slip` gives the law on walls (lammps_plugin/README.md, "On LAMMPS 2023 and
-later"; tests/test_lammps_granular*.py), and LAMMPS 2025's own wall/gran hooke/history is no
+tangential stick_slip` gives the law on walls (lammps_plugin/README.md, "On LAMMPS built from
+source"; tests/test_lammps_granular*.py), and LAMMPS 2025's own wall/gran hooke/history is no
 longer the wall the legacy fix renames (test_the_wall_moves_to_the_sub_model). These tests need LAMMPS 2025
 (STICKSLIP_SOURCE_BUILDS=lammps-2025 ./run.sh setup, which builds the plugin too): they skip
 without it, and fail as root (CI). Costs (2 cores): pour ~2 s serial, ~5 s on 2 ranks;
@@ -147,7 +147,7 @@ run 1
 
 
 def test_the_wall_moves_to_the_sub_model(tmp_path):
-    """Why the plugin has no wall fix (lammps_plugin/README.md, "On LAMMPS 2023 and later"):
+    """Why the plugin has no wall fix (lammps_plugin/README.md, "On LAMMPS built from source"):
     one grain (R = 0.5, overlap 0.01) dragged along a floor for one step. Debian's LAMMPS's
     wall/gran hooke/history, which the legacy wall/gran/stickslip renames, gives
     F_x = -(Kt v dt + meff gamma_t v) (measured there: -0.03617993877991494), as pair

@@ -6,7 +6,7 @@ count and the dissipated work), on the same rank count and across rank counts; a
 LAMMPS (lammps/lammps#3022, lammps_plugin/contact_history_fix.h).
 
 "Exactly" means: a new `run` re-evaluates every force in its set-up, with stock styles too
-(lammps_plugin/README.md, "Found in this LAMMPS"), so the reference for a restarted run is
+(lammps_plugin/README.md, "What this LAMMPS does, with stock styles too"), so the reference for a restarted run is
 the same script split at the same step in one process (`run N1` then `run N2`), not one
 uninterrupted run. On the same rank count the restarted run's dumps must be those bytes.
 Across rank counts the forces on a grain are summed in another order, so the trajectories

@@ -4,7 +4,7 @@
 the CPU: what the engine's float geometry does to them, with and without the force model's
 own distance in double (deme_model/stick_slip.cu, step 0).
 
-    .venv/bin/python tools/deme_plane_emulation.py [drag|tilt ...] [--steps N]
+    .venv/bin/python tools/deme_plane_emulation.py [drag|tilt ...] [--steps N] [--every N]
 
 Each step does what DEM-Engine 3.0.19's sphere-plane force kernel does before the model
 (DEMCalcForceKernels_Primitive.cu, DEMCollisionKernels_SphSph.cuh):
@@ -139,8 +139,9 @@ def emulate(scene, model_distance):
     return adapter._Recording(t, xs, vs, fn, ft, slips, angles)
 
 
-def report(name, steps=None, log=print):
-    """The three runs of one case and their figures: {label: {figure: value}}."""
+def report(name, steps=None, log=print, every=None):
+    """The three runs of one case and their figures: {label: {figure: value}}, read every
+    `every` steps (None: the scene's rows; the GPU check reads the tilt every 50)."""
     from deme_fn_ring import fn_spread
     from pyref import Simulation
     from stickslip import analysis, columns
@@ -149,6 +150,8 @@ def report(name, steps=None, log=print):
     sc = scene_mod.load(name)
     if steps is not None:
         sc.duration = steps * sc.dt
+    if every is not None:
+        sc.output.every = every
     out = {}
     for label, model_distance in (("engine overlap", False), ("model distance", True), ("pyref", None)):
         t0 = time.perf_counter()
@@ -165,9 +168,11 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("cases", nargs="*", default=["drag", "tilt"])
     ap.add_argument("--steps", type=int, default=None, help="run this many steps, not the scene's")
+    ap.add_argument("--every", type=int, default=None,
+                    help="read a row every N steps, not the scene's (the GPU check reads the tilt every 50)")
     args = ap.parse_args(argv)
     for name in args.cases:
-        res = report(name, args.steps, log=lambda s: print(s, file=sys.stderr, flush=True))
+        res = report(name, args.steps, log=lambda s: print(s, file=sys.stderr, flush=True), every=args.every)
         labels = list(res)
         keys = [k for k in res["pyref"] if all(k in res[lab] for lab in labels)]
         print(f"\n{name}: " + " | ".join(labels))

@@ -58,7 +58,7 @@ def _part(task):
 
     _, fn, args = task
     if fn is run_named:
-        scene, engine, _, overrides = args
+        scene, engine, _, overrides = args[:4]
         return f"{'ladder' if 'dt' in overrides else 'case'} {scene} on {engine}"
     return fn.__module__.rsplit(".", 1)[-1]
 

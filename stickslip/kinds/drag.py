@@ -97,8 +97,8 @@ def figures(out, runs):
     for (law, timing, eng), (sc, s, df) in runs.items():
         c, g = prefix(sc), sc.analysis["grain"]
         disp = (df[f"{g}_x"] - df[f"{g}_x"].iloc[0]) * 1e6
-        a.plot(disp, df[f"{c}_fs"], **plotstyle.line(eng), label=eng)
-        b.plot(disp, disp - df[f"{c}_fs"] / sc.contact.ks * 1e6, **plotstyle.line(eng), label=eng)
+        a.plot(disp, df[f"{c}_fs"], **plotstyle.line(eng), label=plotstyle.label(eng, timing))
+        b.plot(disp, disp - df[f"{c}_fs"] / sc.contact.ks * 1e6, **plotstyle.line(eng), label=plotstyle.label(eng, timing))
         fn, p = s["fn_mean_N"], sc.contact
     if fn is None:
         plt.close(fig)
@@ -119,7 +119,7 @@ def precision_figures(out, runs):
 
 
 def paper_statements(scene):
-    """Paper §3.1 beside ours (kinds/paper.py)."""
+    """Paper §3.1 beside the runs' figures (kinds/paper.py)."""
     p = scene.contact
     return [
         Statement("§3.1", "In the static phase the friction rises linearly to the static threshold μs·Fn",

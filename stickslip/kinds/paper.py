@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The paper's statements beside ours: each kind lists what its section of the paper says
-that can be checked (or not), and how our summary figures check it.
+"""The paper's statements beside the runs' figures: each kind lists what its section of the
+paper says that can be checked (or not), and how the runs' summary figures check it.
 
-A Statement's `value` reads our figure from one run's summary; `check` says whether it
+A Statement's `value` reads the figure from one run's summary; `check` says whether it
 matches the paper (None: the statement cannot be checked from a run). `why` explains,
 in one sentence per slip timing ("step", "exact", or "" for both), a difference.
 """
@@ -16,11 +16,11 @@ from typing import Callable
 class Statement:
     section: str  # e.g. "§3.1"
     text: str  # what the paper says
-    value: Callable[[dict], object] | None  # our figure from a run's summary
+    value: Callable[[dict], object] | None  # the figure, from a run's summary
     check: Callable[[object], bool] | None  # matches the paper?
     law: str = "stick_slip"  # the run it is judged on
     why: dict = field(default_factory=dict)  # slip timing ("" = any) -> sentence, where it differs
-    how: str = ""  # how we read the statement (tolerance and its reason)
+    how: str = ""  # how the statement is read (tolerance and its reason)
 
 
 def rows(statements, runs, fmt):

@@ -134,31 +134,32 @@ def figures(out, runs):
     fig, (a, b) = plt.subplots(2, 1, figsize=(7, 7))
     for (law, timing, eng), (sc, s, df) in runs.items():
         c, angle = _prefix(sc), df[f"{sc.analysis['wall']}_angle"]
-        a.plot(df["t"], df[f"{c}_fs"], **plotstyle.line(eng), label=f"|Fs| [{eng}]")
+        a.plot(df["t"], df[f"{c}_fs"], **plotstyle.line(eng, timing), label=f"|Fs|: {plotstyle.label(eng, timing)}")
         t_stop = df["t"][np.argmax(angle.to_numpy())]
         z = df["t"] >= t_stop - 0.005
-        b.plot(df["t"][z], df[f"{c}_fs"][z], **plotstyle.line(eng), lw=0.7, label=eng)
+        b.plot(df["t"][z], df[f"{c}_fs"][z], **plotstyle.line(eng, timing), lw=0.7, label=plotstyle.label(eng, timing))
     ax2 = a.twinx()
-    ax2.plot(df["t"], np.tan(angle), "r-", lw=0.8)
-    ax2.set_ylabel("tan β", color="r")
+    ax2.plot(df["t"], np.tan(angle), "k-", lw=0.8)  # (black: the timings' colours are the runs')
+    ax2.set_ylabel("tan β (black)")
     a.set_xlabel("t (s)")
     a.set_ylabel("friction force (N/m)")
     a.legend(loc="upper left")
     b.set_xlabel("t (s)")
     b.set_ylabel("friction force (N/m)")
     b.legend()
-    a.set_title("Fig. 14 — tilt: (a) friction and tan β, (b) after the plate stops")
+    a.set_title("Fig. 14 — tilt: (a) friction and tan β, (b) after the plate stops (colour: slip timing)")
     names = [plotstyle.save(fig, out, "fig14_tilt_friction.png")]
     # Fig. 15: speed along the plate after the first slip.
     fig, ax = plt.subplots(figsize=(7, 4))
     for (law, timing, eng), (sc, s, df) in runs.items():
         z = df["t"] >= (s["t_first_slip_s"] or 0) - 0.002
-        ax.plot(df["t"][z], speed_down_plate(sc, df)[z] * 1e3, **plotstyle.line(eng), label=eng)
+        ax.plot(df["t"][z], speed_down_plate(sc, df)[z] * 1e3, **plotstyle.line(eng, timing),
+                label=plotstyle.label(eng, timing))
         if s.get("t_steady_s"):
-            ax.axvline(s["t_steady_s"], color="gray", lw=0.5)
+            ax.axvline(s["t_steady_s"], color=plotstyle.TIMING_COLOURS[timing], lw=0.5, alpha=0.5)
     ax.set_xlabel("t (s)")
     ax.set_ylabel("speed down the plate (mm/s)")
-    ax.set_title("Fig. 15 — tilt: stick-slip, then steady sliding (grey line)")
+    ax.set_title("Fig. 15 — tilt: stick-slip, then steady sliding (thin lines: its start)")
     ax.legend()
     names.append(plotstyle.save(fig, out, "fig15_tilt_velocity.png"))
     return names
@@ -173,7 +174,7 @@ def precision_figures(out, runs):
         if s["t_first_slip_s"] is None:
             continue
         sel = df["t"].to_numpy() >= s["t_first_slip_s"] - 0.002
-        label = f"{timing}, dt = {dt:.1e} s"
+        label = f"{plotstyle.label(eng, timing)}, dt = {dt:.1e} s"
         if timing == "step":
             g = next(q for q in sc.grains if q.name == sc.analysis["grain"])
             fn = sc.grain_mass(g) * float(np.linalg.norm(sc.gravity)) / math.sqrt(1 + s["tan_beta_stop"] ** 2)
@@ -189,7 +190,7 @@ def precision_figures(out, runs):
 
 
 def paper_statements(scene):
-    """Paper §3.3 beside ours (kinds/paper.py)."""
+    """Paper §3.3 beside the runs' figures (kinds/paper.py)."""
     p = scene.contact
     exact_why = ("with each slip at its time the stick stage is resolved at any dt: the mean friction rises with "
                  "speed (μk + νs·V/(2Fn)) until the dashpot alone covers the drop, then falls to 2μk−μs within "

@@ -120,7 +120,7 @@ def figures(out, runs):
     # Fig. 11: height of grain 1 for the three laws.
     fig, ax = plt.subplots(figsize=(7, 4))
     for (law, timing, eng), (sc, s, df) in runs.items():
-        ax.plot(df["t"], height(sc, df) * 1e3, **plotstyle.line(eng), label=f"{law} [{eng}]")
+        ax.plot(df["t"], height(sc, df) * 1e3, **plotstyle.line(eng), label=plotstyle.label(eng, timing, law))
         r = _grain(sc).radius
     ax.axhline(r * 1e3, color="k", lw=0.5)
     ax.set_xlabel("t (s)")
@@ -138,7 +138,7 @@ def figures(out, runs):
             n = _floor(sc).normal
             sign = 1.0 if a == sc.analysis["grain"] else -1.0  # the force on grain 1
             f = sign * sum(df[f"{a}-{b}_ft{x}"].to_numpy() * n[k] for k, x in enumerate("xyz"[: sc.dimension]))
-            ax.plot(df["t"], f, **plotstyle.line(eng), lw=0.8, label=eng)
+            ax.plot(df["t"], f, **plotstyle.line(eng), lw=0.8, label=plotstyle.label(eng, timing))
         ax.set_ylabel("Fs, vertical (N/m)")
         ax.set_title(law, fontsize=9)
         ax.legend(fontsize=8)
@@ -152,13 +152,13 @@ def precision_figures(out, runs):
     return []
 
 
-# "close to 0.6 N": the paper quotes one digit; we read it as within 10 %.
+# "close to 0.6 N": the paper quotes one digit; read as within 10 %.
 PAPER_FRICTION_N = 0.6
 PAPER_VISCO_PLASTIC_BOTTOM_S = 2.65
 
 
 def paper_statements(scene):
-    """Paper §3.2 beside ours (kinds/paper.py)."""
+    """Paper §3.2 beside the runs' figures (kinds/paper.py)."""
     return [
         Statement("§3.2", "Stick-slip: grain 1 is held above the bottom of the tray",
                   lambda s: s["reached_bottom"], lambda v: v is False, how="grain 1's centre stays above r"),

@@ -138,15 +138,17 @@ def answer(r, targets, surf, rows, lag, path, rolling, widening):
     coefficients = {}
     for name in ("mu_s", "mu_k"):
         lo, hi = r.ranges[name]
+        values = r.surf.ms if name == "mu_s" else r.surf.mk
         coefficients[name] = {"value": getattr(r, name), "range": [lo, hi],
                               "cut": {"low": r.cut.get((name, "lo")), "high": r.cut.get((name, "hi"))},
+                              "extent": [float(values.min()), float(values.max())],
                               "k": math.sqrt(r.delta[name]) / r.widen, "dof": r.dof[name]}
     dof = len(targets) - 2
     s = calibrate_map.scores(rows)
     return _finite({
         **coefficients, "fmin_over_fn": 2 * r.mu_k - r.mu_s, "edge": list(r.edge),
         "ranges": {"confidence": calibrate_fit.COVER, "widened_by": r.widen, "widening_from_ranges": widening[1],
-                   "joint_delta_chi2": r.delta["joint"]},
+                   "joint_delta_chi2": r.delta["joint"], "note": widening[2]},
         "chi2": r.chi2,
         "agreement": {"dof": dof, "p": float(chi2_dist.sf(r.chi2, dof))} if dof > 0 else None,
         "targets": {a: {"value": t.value, "se": t.se, "n": t.n} for a, t in targets.items()},
@@ -162,22 +164,42 @@ def _number(value, d):
     return f"{value:.{d}f}"
 
 
+def _exact(value, d):
+    """`value` (a point of the grid: a multiple of its step) with at least d decimals and as
+    many more as it needs, up to the grid's 4."""
+    return next(_number(value, k) for k in range(d, 5) if abs(round(value, k) - value) < 1e-9 or k == 4)
+
+
+def _outward(value, d, side, extent):
+    """An uncut end rounded outwards (down for the low end, up for the high one) to d decimals,
+    or to more where that would reach the map's extent: a printed end that is the map's edge
+    must be one (only a cut end is, and it is printed as it is)."""
+    for k in range(d, 5):
+        shown = (math.floor(value * 10 ** k + 1e-6) if side == "low" else math.ceil(value * 10 ** k - 1e-6)) / 10 ** k
+        if extent[0] + 1e-9 < shown < extent[1] - 1e-9:
+            return _number(shown, k)
+    return _exact(value, d)
+
+
 def _coefficient_line(name, c):
-    """"mu_s = 0.58 (0.50 to 0.65; 0.65 is the law's bound mu_k = mu_s / 2, not an uncertainty)":
-    the value to the digits its range allows, the range rounded outwards."""
+    """"mu_s = 0.6 (0.3475 to 0.93; 0.3475 is the law's bound mu_k = mu_s, not an uncertainty)":
+    the value to the digits its range allows; an end that an edge cuts printed as it is (the
+    edge's value there), the others rounded outwards without reaching the map's extent, so that
+    the printed range holds the computed one and each end named an edge is that edge."""
     (lo, hi), d = c["range"], decimals(*c["range"])
-    ends = [_number(math.floor(lo * 10 ** d + 1e-6) / 10 ** d, d), _number(math.ceil(hi * 10 ** d - 1e-6) / 10 ** d, d)]
-    text = f"{name} = {_number(c['value'], d)} ({ends[0]} to {ends[1]}"
-    for end, side in zip(ends, ("low", "high")):
+    ends = [(_exact(v, d) if c["cut"][side] else _outward(v, d, side, c["extent"]), side)
+            for v, side in ((lo, "low"), (hi, "high"))]
+    text = f"{name} = {_number(c['value'], d)} ({ends[0][0]} to {ends[1][0]}"
+    for end, side in ends:
         if c["cut"][side]:
-            text += f"; {end} is {EDGE[c['cut'][side]]}, not an uncertainty"
+            text += f"; {end} is {' and '.join(EDGE[e] for e in c['cut'][side])}, not an uncertainty"
     return text + ")"
 
 
 def _ranges_line(a):
     widened, cover = a["ranges"]["widened_by"], f"{a['ranges']['confidence'] * 100:.0f} %"
     how = (f", widened by {widened:.2f} as measured on the map's own points" if widened > 1 else
-           "" if a["ranges"]["widening_from_ranges"] else "; not widened: no leave_pair_out.csv beside the map")
+           "" if a["ranges"]["widening_from_ranges"] else "; not widened (first line)")
     return (f"each range: where its coefficient lies with {cover} confidence, the other left free (the map's spread, "
             f"its interpolation's error and the targets' errors{how}); --details: the statistics")
 
@@ -201,7 +223,9 @@ def _agreement_text(a):
 
 def plain(a):
     """The answer in plain words: the lines calibrate prints without --details."""
-    lines = [_coefficient_line(n, a[n]) for n in ("mu_s", "mu_k")] + [_ranges_line(a)]
+    note = a["ranges"]["note"]
+    lines = [note] if note else []
+    lines += [_coefficient_line(n, a[n]) for n in ("mu_s", "mu_k")] + [_ranges_line(a)]
     lines += [f"edge: the answer lies on {EDGE[e]} (mu_s {a['mu_s']['value']:.3f}, mu_k {a['mu_k']['value']:.3f}): "
               f"{BEYOND[e]}; read it as a bound" for e in a["edge"]]
     warning = _agreement_text(a)[1]
@@ -220,10 +244,12 @@ def details(a):
     lines = [f"2 mu_k - mu_s = {a['fmin_over_fn']:.3f} (the force a slipping contact holds, over Fn)",
              "ranges: chi2 within (k f)^2 of its least, the other coefficient profiled; k Student's t at the degrees "
              f"of freedom of the errors the coefficient comes from (1 for known errors): mu_s {_k(a['mu_s'])}, mu_k "
-             f"{_k(a['mu_k'])}; f = {ranges['widened_by']:.2f}, the widening that makes 68 % of the ranges hold the "
-             "truth when each of the map's points is left out and answered by the others "
-             f"({ranges['widening_from_ranges']} ranges, leave_pair_out.csv); the joint 68 % region of (mu_s, mu_k) "
-             "is chi2 within "
+             f"{_k(a['mu_k'])}; "
+             + ("f = 1, not widened (first line)" if ranges["note"] else
+                f"f = {ranges['widened_by']:.2f}, the widening that makes 68 % of the ranges hold the truth when each "
+                "of the map's points is left out and answered by the others "
+                f"({ranges['widening_from_ranges']} ranges, leave_pair_out.csv)")
+             + "; the joint 68 % region of (mu_s, mu_k) is chi2 within "
              f"{ranges['joint_delta_chi2']:.2f} of its least (--region-png draws it)",
              "targets: " + ", ".join(f"{n} {t['value']:.2f}" + (f" +- {t['se']:.2f}" if t["se"] else "") + unit(n)
                                      + (f" (mean of {t['n']})" if t["n"] else "" if t["se"] else " (exact)")

@@ -38,6 +38,7 @@ from ..errors import SceneError
 from . import calibrate_map
 
 GRID = 0.0025  # grid step in mu
+ORDER = ("map", "mu_k = mu_s", "mu_k = mu_s / 2")  # the edges a range or an answer can touch
 COVER = calibrate_map.COVER
 DELTA_PROFILE = 1.0  # one coefficient, the other profiled, known errors: chi2 quantile 0.6827 with 1 dof
 DELTA_JOINT = 2.30  # the pair, known errors: chi2 quantile 0.6827 with 2 dof
@@ -137,7 +138,7 @@ class Result:
     field: np.ndarray  # chi2 on the grid (inf outside)
     surf: Surfaces
     ranges: dict  # {"mu_s": (lo, hi), "mu_k": (lo, hi)}
-    cut: dict  # {("mu_s", "lo" | "hi"): "map" | "mu_k = mu_s" | "mu_k = mu_s / 2" (the law's bounds)}
+    cut: dict  # {("mu_s", "lo" | "hi"): the edges that cut it, of ORDER ("map"; the law's bounds)}
     at_best: dict  # {target: (mean, se)} of the map at the answer
     delta: dict  # {"mu_s" | "mu_k" | "joint": delta chi2 of its 68.27 %; the ranges' widened by widen^2}
     dof: dict  # {"mu_s" | "mu_k": Welch-Satterthwaite degrees of freedom}
@@ -282,19 +283,16 @@ def _answer_edge(surf, inside, best):
             j = list(best)
             j[axis] += step
             found.add(_beyond(surf, inside, *j))
-    return tuple(e for e in ("map", "mu_k = mu_s", "mu_k = mu_s / 2") if e in found)
+    return tuple(e for e in ORDER if e in found)
 
 
 def _edge(surf, region, inside, axis, i, step):
-    """Whether the region's extreme row/column i along `axis` is cut by the domain there: "map"
-    (the map's hull or extent), the law's bound ("mu_k = mu_s", "mu_k = mu_s / 2"), or None
-    (the region closes inside)."""
+    """What cuts the region's extreme row/column i along `axis`: the edges beyond it there, in
+    ORDER ("map": the map's hull or extent; the law's bounds "mu_k = mu_s", "mu_k = mu_s / 2"),
+    each once; () where the region closes inside."""
     line = region[i] if axis == 0 else region[:, i]
-    for j in np.nonzero(line)[0]:
-        where = _beyond(surf, inside, *((i + step, j) if axis == 0 else (j, i + step)))
-        if where:
-            return where
-    return None
+    found = {_beyond(surf, inside, *((i + step, j) if axis == 0 else (j, i + step))) for j in np.nonzero(line)[0]}
+    return tuple(e for e in ORDER if e in found)
 
 
 def _beyond(surf, inside, s_i, k_i):

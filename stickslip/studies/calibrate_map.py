@@ -65,27 +65,43 @@ NUMBERS = ("mu_s", "mu_k", "rolling")
 
 
 def read_points(path):
-    """The map's points from a CSV, or SceneError in one line naming the file, the column and
-    what was expected: the columns LABELS and NUMBERS, numbers where numbers belong, no empty
-    cell in NUMBERS, and for every target it has a mean of, that mean's standard error."""
+    """The map's points from a CSV, or SceneError in one line naming the file, the column (and
+    the line where there is one) and what was expected: only the columns study-3d writes, the
+    columns LABELS and NUMBERS, a standard error beside every mean (a mean beside every other
+    statistic: a renamed mean), finite numbers where numbers are (a "nan" or "inf" written in a
+    cell is refused; only an empty cell is "not measured"), no empty cell in NUMBERS, a mean in
+    every map row of its target's kind, and no row or map point twice."""
     path = Path(path)
     if not path.is_file():
         raise SceneError(f"--map {path}: not found (stickslip study-3d writes it)")
+    where = f"--map {path}"
     try:
-        pts = pd.read_csv(path, dtype={c: str for c in LABELS})
+        # keep_default_na=False: "nan", "NA", "null" stay text (refused below), an empty cell is NaN
+        pts = pd.read_csv(path, dtype={c: str for c in LABELS}, keep_default_na=False, na_values=[""])
     except (OSError, ValueError, pd.errors.ParserError) as e:  # (UnicodeDecodeError is a ValueError)
-        raise SceneError(f"--map {path}: cannot be read as CSV ({' '.join(str(e).split())[:120]})") from None
+        raise SceneError(f"{where}: cannot be read as CSV ({' '.join(str(e).split())[:120]})") from None
+    known = granular3d_tables.point_columns()
+    unknown = [c for c in pts if c not in known]
+    if unknown:
+        raise SceneError(f"{where}: column {unknown[0]!r} is not a column of a map (points.csv of stickslip "
+                         f"study-3d: {', '.join(LABELS + NUMBERS)}, each figure's "
+                         f"{'/'.join(granular3d_tables.STATISTICS)}, fills)")
     missing = [c for c in (*LABELS, *NUMBERS) if c not in pts]
     if missing:
-        raise SceneError(f"--map {path}: no column {missing[0]!r}: a map has the columns {', '.join(LABELS + NUMBERS)} "
+        raise SceneError(f"{where}: no column {missing[0]!r}: a map has the columns {', '.join(LABELS + NUMBERS)} "
                          "(points.csv of stickslip study-3d)")
     means = [t for t in TARGETS if f"{t}_mean" in pts]
     if not means:
-        raise SceneError(f"--map {path}: no column of a target's mean: expected one of "
+        raise SceneError(f"{where}: no column of a target's mean: expected one of "
                          f"{', '.join(t + '_mean' for t in TARGETS)}")
+    for figure in granular3d_tables.MEASURED:
+        beside = [f"{figure}_{k}" for k in granular3d_tables.STATISTICS[1:] if f"{figure}_{k}" in pts]
+        if beside and f"{figure}_mean" not in pts:
+            raise SceneError(f"{where}: column {beside[0]} has no {figure}_mean beside it: expected each statistic "
+                             "beside its mean")
     for t in means:
         if f"{t}_se" not in pts:
-            raise SceneError(f"--map {path}: column {t}_mean has no {t}_se beside it: expected each mean's standard "
+            raise SceneError(f"{where}: column {t}_mean has no {t}_se beside it: expected each mean's standard "
                              "error")
     for c in (*NUMBERS, *(f"{t}_{s}" for t in means for s in ("mean", "se", "n") if f"{t}_{s}" in pts)):
         v = pd.to_numeric(pts[c], errors="coerce")
@@ -95,10 +111,47 @@ def read_points(path):
         if bad.any():
             i = int(np.argmax(bad.to_numpy()))
             cell = "empty" if pd.isna(pts[c].iloc[i]) else repr(str(pts[c].iloc[i]))
-            raise SceneError(f"--map {path}: column {c}, line {i + 2}: {cell}: expected a finite number"
+            raise SceneError(f"{where}: column {c}, line {i + 2}: {cell}: expected a finite number"
                              + (" (the standard error of the mean beside it)" if c.endswith("_se") else ""))
         pts[c] = v
+    _check_rows(pts, where)
     return pts
+
+
+def _check_rows(pts, where):
+    """SceneError in one line for a row written twice, a map point of one kind measured twice
+    (two rows at one (mu_s, mu_k) and rolling resistance), or a map row without the mean of a
+    target its kind measures (a point the map would otherwise drop without a word). Lines are
+    the file's (the header is line 1)."""
+    later = np.flatnonzero(pts.duplicated().to_numpy())
+    if len(later):
+        i = later[0]
+        j = next(k for k in range(i) if pts.iloc[k].equals(pts.iloc[i]))
+        raise SceneError(f"{where}: line {i + 2} repeats line {j + 2}: each row once")
+    on = on_map(pts)
+    key = ["kind", "mu_s", "mu_k", "rolling", "nu_s", "timing"]
+    points = pts[on]
+    later = np.flatnonzero(points.duplicated(key).to_numpy())
+    if len(later):
+        i = points.index[later[0]]
+        a = points.loc[i]
+        j = next(k for k in points.index if k != i and all(points.loc[k, c] == a[c] for c in key))
+        raise SceneError(f"{where}: lines {j + 2} and {i + 2}: two map points of kind {a.kind} at mu_s {a.mu_s:g}, "
+                         f"mu_k {a.mu_k:g}, rolling {a['rolling']:g}: each point once")
+    for t, kind in KIND.items():
+        if f"{t}_mean" not in pts:
+            continue
+        empty = on & (pts.kind == kind) & pts[f"{t}_mean"].isna()
+        if empty.any():
+            i = int(np.argmax(empty.to_numpy()))
+            raise SceneError(f"{where}: column {t}_mean, line {i + 2}: empty: expected a finite number (a map row of "
+                             f"kind {kind} measures {t})")
+
+
+def on_map(pts):
+    """Where pts's rows are the map's points (map_rows, any rolling resistance)."""
+    return ((pts["engine"] == "liggghts") & pts["group"].isin(GROUPS)
+            & ((pts.mu_s == pts.mu_k) | ((pts.nu_s == "paper") & (pts.timing == "step"))))
 
 
 def lag_of(path, pts):
@@ -148,17 +201,46 @@ def widening(rows, rolling):
     return math.sqrt(max(float(np.quantile(ratios, COVER)), 1.0)), len(ratios)
 
 
+# leave_pair_out.csv's columns that widening() reads, and which of them hold numbers
+WIDENING_COLUMNS = ("rolling", "refused", "mu_s_cut", "mu_k_cut", "mu_s_ratio", "mu_k_ratio")
+WIDENING_NUMBERS = ("rolling", "mu_s_ratio", "mu_k_ratio")
+
+
 def widening_of(path, rolling):
-    """widening() from leave_pair_out.csv beside the map, or (1.0, 0) where there is none."""
+    """(f, ranges, note): widening() from leave_pair_out.csv beside the map; where there is no
+    such file, or it has no ranges at this rolling resistance, f = 1 and `note` says so in one
+    line (calibrate prints it first: the ranges are then as stated, not widened). A file that is
+    not a leave_pair_out.csv is SceneError in one line naming it, the column and the line."""
     lpo = Path(path).with_name("leave_pair_out.csv")
     if not lpo.is_file():
-        return 1.0, 0
+        return 1.0, 0, (f"note: no leave_pair_out.csv beside --map {path}: the ranges are not widened by the map's "
+                        "own measure (f = 1), so they may hold the truth less often than 68 % (stickslip study-3d "
+                        "writes it beside points.csv)")
+    where = f"{lpo} (beside --map)"
     try:
-        rows = pd.read_csv(lpo)
-        return widening(rows, rolling)
-    except (OSError, ValueError, KeyError, pd.errors.ParserError) as e:
-        raise SceneError(f"{lpo} (beside --map): not a leave_pair_out.csv of stickslip study-3d "
-                         f"({type(e).__name__}: {' '.join(str(e).split())[:80]})") from None
+        rows = pd.read_csv(lpo, keep_default_na=False, na_values=[""])
+    except (OSError, ValueError, pd.errors.ParserError) as e:
+        raise SceneError(f"{where}: cannot be read as CSV ({' '.join(str(e).split())[:120]})") from None
+    missing = [c for c in WIDENING_COLUMNS if c not in rows]
+    if missing:
+        raise SceneError(f"{where}: no column {missing[0]!r}: expected leave_pair_out.csv of stickslip study-3d "
+                         f"({', '.join(WIDENING_COLUMNS)})")
+    answered = blank(rows.refused)
+    for c in WIDENING_NUMBERS:
+        v = pd.to_numeric(rows[c], errors="coerce")
+        # a ratio may be infinite (a truth off the map that is left: widening() leaves it out)
+        bad = (rows[c].isna() | v.isna() | (np.isinf(v) & (c == "rolling"))) & (answered | (c == "rolling"))
+        if bad.any():
+            i = int(np.argmax(bad.to_numpy()))
+            cell = "empty" if pd.isna(rows[c].iloc[i]) else repr(str(rows[c].iloc[i]))
+            raise SceneError(f"{where}: column {c}, line {i + 2}: {cell}: expected a number")
+        rows[c] = v
+    f, ranges = widening(rows, rolling)
+    if not ranges:
+        return 1.0, 0, (f"note: {lpo.name} beside --map {path} has no ranges uncut by an edge at --rolling {rolling:g}: "
+                        "the ranges are not widened by the map's own measure (f = 1), so they may hold the truth less often than "
+                        "68 %")
+    return f, ranges, None
 
 
 def map_rows(pts, rolling, nu_s="paper", source="the map"):

@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""Mean friction against imposed sliding speed (drag scene), step and exact slip timing.
+"""Mean friction against imposed sliding speed (drag scene), step and exact slip timing: a
+study of `stickslip report` (report_plan.py), not a command of its own.
 
 The paper's Fig. 4/15 message is that friction falls with sliding speed. With the
 law stepped as the paper does, part of that fall is the time step: every step slips
@@ -17,7 +18,7 @@ import numpy as np
 from pyref import Simulation
 from pyref.laws import every_step_slips_speed
 
-from .. import parallel, plotstyle, runner
+from .. import plotstyle, runner
 from .. import scene as scene_mod
 
 SPEEDS = np.logspace(-6, -2, 17)  # m/s: 4 decades, past the dashpot threshold (~1e-3 m/s)
@@ -54,11 +55,6 @@ def mean_friction(base, speed, dt, timing):
         return float("nan")
     # whole periods: from just after the first slip to the last one
     return float(ratio[slips[0] + 1: slips[-1] + 1].mean())
-
-
-def run_friction_speed(out: Path, scene="drag", speeds=SPEEDS, dt_factors=DT_FACTORS, progress=True):
-    tasks, finish = plan(out, scene, speeds, dt_factors)
-    return finish(parallel.run_all(tasks, "friction vs speed", progress))
 
 
 def plan(out: Path, scene="drag", speeds=SPEEDS, dt_factors=DT_FACTORS):
@@ -106,7 +102,7 @@ def _plot(base, rows, path):
         for timing, ls in (("step", "--"), ("exact", "-")):
             rr = [r for r in rows if r["dt_s"] == dt and r["slip_timing"] == timing]
             ax.semilogx([r["speed_mps"] for r in rr], [r["mean_fs_fn"] for r in rr], ls, marker=".",
-                        color=f"C{k}", label=f"{timing}, dt = {dt:.1e} s")
+                        color=f"C{k}", label=f"{plotstyle.label('pyref', timing)}, dt = {dt:.1e} s")
         ax.axvline(every_step_slips_speed(law, fn, dt), color=f"C{k}", lw=0.5, ls=":")
     ax.axvline(2 * (p.mu_s - p.mu_k) * fn / law.nu_s, color="k", lw=0.8, ls=":") if law.nu_s else None
     ax.axhline(p.mu_k, color="gray", lw=0.5)

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """How far `stickslip calibrate` holds, measured on the study's own runs (docs/granular-3d.md,
-"How far the calibration holds"): written by `stickslip study-3d` beside its other tables.
+"When the map holds"): written by `stickslip study-3d` beside its other tables.
 
 - loo.csv: the map's leave-one-out, each point predicted from the others by each interpolation
   (calibrate_map.loo), per rolling resistance, and interpolation.csv: each method's score and
@@ -80,7 +80,7 @@ def measured(cov):
 
 
 def _cuts(r, name):
-    return " ".join(f"{e}: {w}" for (n, e), w in r.cut.items() if n == name)
+    return " ".join(f"{e}: {' and '.join(w)}" for (n, e), w in r.cut.items() if n == name)
 
 
 def coverage(pts, method="auto", surf=None, widenings=(1.0,)):

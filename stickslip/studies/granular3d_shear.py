@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The sheared layer's tables (kind shear3d, docs/granular-3d.md "A measurement that tells mu_s
-from mu_k"), written by `stickslip study-3d` beside its others once the study ran the layer:
+"""The sheared layer's tables (kind shear3d, docs/granular-3d.md "A measurement that tells μs
+from μk"), written by `stickslip study-3d` beside its others once the study ran the layer:
 
 - sensitivity.csv: each observable of the layer (shear_peak, shear_steady, shear_dilation) against
   mu_s - mu_k on each line of fixed mu_k (granular3d.SHEAR_LINES, no rolling resistance): the

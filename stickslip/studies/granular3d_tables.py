@@ -30,6 +30,14 @@ VALIDATION_TOLERANCE = 0.7  # degrees (issue 39)
 DEEP_LAYERS, DEEP = 36, 20  # the deep bed: lattice layers (granular3d.DEEP_LAYERS), depth in d
 KEYS = ["kind", "engine", "group", "material", "mu_s", "mu_k", "nu_s", "timing", "rolling", "layers",
         "rate_factor", "silbert"]
+STATISTICS = ("mean", "std", "se", "n")  # of each measured figure over a point's fills, in points.csv
+MEASURED = ANGLES + ("depth_at_stop", "grains_per_area") + SHEAR  # what points.csv may hold statistics of
+
+
+def point_columns():
+    """Every column points.csv may have (points() writes a figure's columns only where a run
+    measured it): the keys, the statistics of each measured figure, the fills."""
+    return KEYS + [f"{a}_{k}" for a in MEASURED for k in STATISTICS] + ["fills"]
 
 
 def weinhart_theta_stop(depth):
@@ -94,7 +102,7 @@ def points(runs):
             row[f"{a}_n"] = len(v)
         row["fills"] = len(grp)
         rows.append(row)
-    columns = KEYS + [f"{a}_{k}" for a in measured for k in ("mean", "std", "se", "n")] + ["fills"]
+    columns = KEYS + [f"{a}_{k}" for a in measured for k in STATISTICS] + ["fills"]
     return pd.DataFrame(rows, columns=columns)  # the columns even when only held beds ran
 
 

@@ -59,7 +59,8 @@ def _section(out, cases, ladders, speed_rows, threshold_rows, ref):
         d = out / "precision" / case
         rows = list(csv.DictReader(open(csv_path)))
         scene_dt = scene_mod.load(case).dt
-        lines += [f"### {case}", "", f"Data: [{csv_path.name}](precision/{case}/{csv_path.name}).", "",
+        lines += [f"### {case}", "", f"Data: [{csv_path.name}](precision/{case}/{csv_path.name}). "
+                  + precision.warned_line(csv_path), "",
                   "| engine | timing | measure | error at the scene's dt | fitted order |", "|---|---|---|---|---|"]
         for (eng, timing, measure), p in sorted(orders.items()):
             at = [r for r in rows if r["engine"] == eng and r["slip_timing"] == timing

@@ -125,7 +125,8 @@ def _plot(rows, path):
         rr = [r for r in rows if r["nu_s"] == nu]
         dts = [r["dt_s"] for r in rr]
         ax.loglog(dts, [r["v_star_formula_mps"] for r in rr], "-", color="gray")
-        ax.loglog(dts, [r["v_star_measured_mps"] for r in rr], mark, label=f"measured, nu_s = {nu:g} kg/s")
+        ax.loglog(dts, [r["v_star_measured_mps"] for r in rr], mark,
+                  label=f"{plotstyle.label('pyref', 'step')}: measured, nu_s = {nu:g} kg/s")
     ax.set_xlabel("time step dt (s)")
     ax.set_ylabel("speed above which every step slips (m/s)")
     ax.set_title("V* = 2(mu_s - mu_k)Fn / (Ks dt + nu_s)  (grey: formula)")
