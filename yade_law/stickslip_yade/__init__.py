@@ -26,10 +26,11 @@ Where things are, one idea per module:
 - energy.py        the energy books in O.energy
 - checkpoints.py   the state saved with the scene (O.tags) and restored at a load
 - checks.py        what the law accepts: parameters, the scene's engines and shapes; errors
+- compiled.py      the compiled law (yade_law/compiled/) from a script: its engines, its contacts
 - verlet_start.py  velocity_verlet_start: YADE's first step as velocity Verlet's start
 
-Why it is written this way (measured on YADE 2023.02a, see README.md, "How it is fast
-enough"): YADE never calls a Python subclass of a Law2 class and interactions take no extra
+Why it is written this way (measured on YADE 2023.02a, see README.md, "How the Python law is
+fast enough"): YADE never calls a Python subclass of a Law2 class and interactions take no extra
 attributes, so the per-contact state lives here, in arrays, and is saved with the scene
 through O.tags; every attribute read from YADE costs 0.3-0.7 us per contact, about a whole
 step of YADE's native law, so a step reads no per-contact attribute of a sphere pair.
