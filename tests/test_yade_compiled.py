@@ -236,6 +236,17 @@ def test_a_saved_scene_continues_in_a_new_process_to_the_byte(tmp_path, timing):
     assert resumed == whole
 
 
+# ---------------------------------------------------------------- the record
+@pytest.mark.parametrize("timing", ["step", "exact"])
+def test_the_energy_books_balance_on_a_pour(tmp_path, timing):
+    """The compiled law's energy books (the Python law's keys in O.energy) on the 125-sphere
+    pour of tests/test_yade_energy.py, within the bound derived there: O.energy.total() stays
+    at its start value up to the time discretisation's first-order mismatch."""
+    import test_yade_energy as energy
+
+    energy.check_balance(energy.pour(tmp_path, timing, nu_s=0.03, backend="cpp", launcher=LAUNCHER))
+
+
 # ---------------------------------------------------------------- the same law as the Python one
 @pytest.mark.parametrize("scene", shapes.SCENES)
 def test_drop_in_scenes_equal_the_python_law(scene):

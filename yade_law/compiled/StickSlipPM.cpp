@@ -295,6 +295,14 @@ void StickSlipGuard::action()
 {
 	if (!law) return;
 	law->nSlipped = law->slippedNow.exchange(0);
+	if (scene->trackEnergy) {
+		// the law's books exist from the first step on, contacts or not (as the Python law's)
+		scene->energy->add(0, "stickslip_slip", law->slipIx, false);
+		scene->energy->add(0, "stickslip_dashpot", law->dashpotIx, false);
+		scene->energy->add(0, "stickslip_normal_damping", law->normalDampingIx, false);
+		scene->energy->add(0, "stickslip_spring", law->springIx, true);
+		scene->energy->add(0, "stickslip_normal_elastic", law->normalElasticIx, true);
+	}
 	if (law->failed) throw std::runtime_error(law->takeError());
 }
 
