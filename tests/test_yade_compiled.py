@@ -177,6 +177,26 @@ def test_a_non_finite_contact_stops_the_run_naming_the_body(tmp_path):
     assert "\n" not in msg and it == 3
 
 
+def test_a_contact_at_zero_overlap_has_no_spring():
+    """docs/law.md step 3: a contact begins at delta > 0; YADE keeps a sphere touching a wall at
+    zero overlap as a contact, to which the law gives no force and no spring. A grain loaded
+    for 10 steps (spring 10 w, w = V dt), one step at exactly zero overlap, then 5 steps
+    pressed again: its spring restarts from zero (1..5 w, no slip), as after a contact that
+    ended. (The law's contract holds the overlap either pressed or apart.)"""
+    from stickslip.contract import cases as lc, yade as contract_yade
+
+    v = lc.DIAGONAL
+    case = lc.Case("zero_overlap", "step 3", "wall", (lc.Segment(10, v), lc.Segment(1, v, delta=0.0), lc.Segment(5, v)),
+                   lc.D24, lc.D_MU_K)
+    trace = contract_yade.run_cases([case])[0]
+    w = np.array(lc.tangential(case, v)) * lc.DT
+    assert np.array_equal(trace["D"][9], 10 * w) and trace["slips"][9] == 0  # loaded, no slip
+    assert trace["fn"][10] == 0.0 and not trace["F"][10].any() and not trace["D"][10].any()
+    for k in range(1, 6):
+        assert np.array_equal(trace["D"][10 + k], k * w), (k, trace["D"][10 + k])
+        assert np.array_equal(trace["F"][10 + k], -k * w * lc.KS) and trace["fn"][10 + k] == 1.0
+
+
 # ---------------------------------------------------------------- save and load
 SAVE = HEAD + """
 def build():

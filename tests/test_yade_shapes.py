@@ -64,6 +64,8 @@ elif scene.startswith("facet"):
         extra = [RotationEngine(ids=[f], rotationAxis=(0, 0, 1), angularVelocity=2.0, rotateAroundZero=True,
                                 zeroPoint=(0, 0, 0))]
         plan = [(700, None)]
+    elif scene == "facet_rolling":  # the sphere spinning about a tangent: its lever arm (midway in the overlap) counts
+        O.bodies[moving].state.angVel = Vector3(0, 30.0, 0)
 elif scene == "periodic":  # two spheres touching across the x boundary of the cell
     O.periodic = True
     O.cell.setBox(0.1, 0.1, 0.1)
@@ -156,7 +158,8 @@ def longest_stick(flags):
     return best + 1
 
 
-SCENES = ["spheres", "spheres_rolling", "facet", "facet_translating", "facet_rotating", "periodic", "clump"]
+SCENES = ["spheres", "spheres_rolling", "facet", "facet_translating", "facet_rotating", "facet_rolling", "periodic",
+          "clump"]
 
 
 def scene_runs(modes, launcher="yade"):
