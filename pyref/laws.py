@@ -126,7 +126,6 @@ class TangentialStep(NamedTuple):
     slipped: np.ndarray  # (K,) bool: at least one slip during the step
     dissipated_dashpot: np.ndarray | None  # (K,) energy the dashpot took (energy=True)
     dissipated_slip: np.ndarray | None  # (K,) energy the slips took (energy=True)
-    sliding: np.ndarray | None = None  # (K,) bool, static_dynamic: the contact's state after the step
 
 
 def every_step_slips_speed(p: LawParams, fn, dt):
@@ -162,7 +161,8 @@ def tangential_force(D, V_s, fn, dt, p: LawParams, energy=False, sliding=None) -
 
     D: spring elongation from the previous step, already in the tangent plane.
     energy: also return what the dashpot and the slips dissipated (docs/law.md, Energy).
-    sliding: static_dynamic's state of each contact from the previous step (None: all static).
+    sliding: static_dynamic's state of each contact from the previous step (None: all static);
+    its state after the step is `slipped` (a contact whose force was cut is sliding).
     """
     if p.law == "static_dynamic":
         return _static_dynamic(D, V_s, fn, dt, p, energy, np.zeros(len(fn), bool) if sliding is None else sliding)
@@ -357,7 +357,8 @@ def _static_dynamic(D, V_s, fn, dt, p, energy, sliding):
     linear_history/static): steps 3-4 of the stick-slip law, then a Coulomb limit of
     mu_s*Fn for a static contact and mu_k*Fn for a sliding one. A trial force above the
     limit is cut to it, spring and dashpot together carrying it, and the contact is sliding
-    after the step; a trial force at or below it sticks, and the contact is static again."""
+    after the step (`slipped`); a trial force at or below it sticks, and the contact is static
+    again."""
     D_start = D
     D = D + V_s * dt  # eq. 7
     F_t = -p.ks * D - p.nu_s * V_s  # eq. 5
@@ -367,10 +368,10 @@ def _static_dynamic(D, V_s, fn, dt, p, energy, sliding):
     F_s = F_t * np.where(over, limit / np.maximum(mag, 1e-300), 1.0)[:, None]
     D = np.where(over[:, None], -(F_s + p.nu_s * V_s) / p.ks, D)
     if not energy:
-        return TangentialStep(F_s, D, over, None, None, over)
+        return TangentialStep(F_s, D, over, None, None)
     total = -_dot(F_s, V_s) * dt - 0.5 * p.ks * (_dot(D, D) - _dot(D_start, D_start))
     dashpot = p.nu_s * _dot(V_s, V_s) * dt * ~over
-    return TangentialStep(F_s, D, over, dashpot, total - dashpot, over)
+    return TangentialStep(F_s, D, over, dashpot, total - dashpot)
 
 
 def _dot(a, b):

@@ -344,7 +344,7 @@ class Simulation:
                     sliding[old] = self.sliding[order[pos[old]]]
         tan = tangential_force(D, V_s, fn, dt, self.p, energy=self.energy, sliding=sliding)
         if self.p.has_state:
-            self.sliding = tan.sliding
+            self.sliding = tan.slipped  # (static_dynamic: sliding after a step whose force was cut)
         F_s, D, slipped = tan.force, tan.spring, tan.slipped
         if self.slip_stats:
             self.vs_mag = np.sqrt(_dot(V_s, V_s))
