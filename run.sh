@@ -251,17 +251,21 @@ setup_lammps_release() {
 patch_lammps_tree() {
     # patch_lammps_tree TOP: the sub-model enters 4 Jul 2026's tree as a pull request would:
     # tools/lammps_patch.py's patch (sources, documentation, example, unit-test cases), written
-    # against pristine copies of the files it changes (TOP/pristine, kept from the source) and
-    # applied with patch(1); a changed patch first takes the previous one out (the files it added
-    # removed, those it changed restored), whatever was done to them since.
+    # against pristine copies of the files it reads (TOP/pristine, kept from the source: those
+    # it changes and those that show the tree's layout) and applied with patch(1); a changed
+    # patch first takes the previous one out (the files it added removed, those it changed
+    # restored), whatever was done to them since.
     # Returns 0 when the tree changed.
     local top=$1 src=$1/source f applied=$1/source/.stick_slip.patch
-    if [ ! -f "$applied" ]; then
-        rm -rf "$top/pristine"
-        for f in $(.venv/bin/python tools/lammps_patch.py --changed); do
-            mkdir -p "$top/pristine/$(dirname "$f")" && cp "$src/$f" "$top/pristine/$f"
-        done
-    fi
+    [ -f "$applied" ] || rm -rf "$top/pristine"
+    for f in $(.venv/bin/python tools/lammps_patch.py "$src" --reads); do
+        [ -f "$top/pristine/$f" ] && continue
+        if [ -f "$applied" ] && grep -q "^diff --git a/$f " "$applied"; then
+            echo "setup: $top/pristine lacks $f, which the applied patch changed: remove $top/source and set up again" >&2
+            exit 1
+        fi
+        mkdir -p "$top/pristine/$(dirname "$f")" && cp "$src/$f" "$top/pristine/$f"
+    done
     .venv/bin/python tools/lammps_patch.py "$top/pristine" -o "$top/stick_slip.patch"
     cmp -s "$top/stick_slip.patch" "$applied" && return 1
     if [ -f "$applied" ]; then

@@ -16,7 +16,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-LAWS = ("stick_slip", "visco_elastic", "visco_plastic", "coulomb")
+LAWS = ("stick_slip", "visco_elastic", "visco_plastic", "coulomb", "static_dynamic")
+SPRING_LAWS = ("stick_slip", "visco_elastic", "static_dynamic")  # those with a tangential spring Ks
 # The law's options (docs/law.md), as the scene file, pyref, the YADE law and DEM-Engine's
 # model name them: each option's values, the law's default first. Each engine's spelling of
 # them, and of the options only an engine has, is stickslip/law_options.py's table.
@@ -46,7 +47,7 @@ except ImportError:
 
 @dataclass
 class LawParams:
-    law: str  # stick_slip | visco_elastic | visco_plastic | coulomb
+    law: str  # stick_slip | visco_elastic | visco_plastic | coulomb | static_dynamic
     kn: float | None  # None: a caller with its own normal law (the YADE law) does not use it
     nu_n: float | None  # 0 when normal damping is switched off
     ks: float
@@ -62,7 +63,12 @@ class LawParams:
     @property
     def has_spring(self) -> bool:
         """Laws that keep a tangential history (a spring elongation D per contact)."""
-        return self.law in ("stick_slip", "visco_elastic")
+        return self.law in SPRING_LAWS
+
+    @property
+    def has_state(self) -> bool:
+        """Laws that keep a state per contact beside the spring (static or sliding)."""
+        return self.law == "static_dynamic"
 
     def check(self) -> None:
         """The parameter rules of docs/law.md (check_parameters, all of them)."""
@@ -85,7 +91,7 @@ def check_parameters(law="stick_slip", **given) -> dict:
             raise ValueError(f"{name} = {given[name]!r}: must be one of {', '.join(allowed)}")
         if name in given:
             out[name] = given[name]
-    positive = ("kn", "mu_s") + (("ks",) if law in ("stick_slip", "visco_elastic") else ())
+    positive = ("kn", "mu_s") + (("ks",) if law in SPRING_LAWS else ())
     for name in ("kn", "ks", "mu_s", "nu_n", "nu_s", "mu_k"):
         if name not in given:
             continue
@@ -104,6 +110,12 @@ def check_parameters(law="stick_slip", **given) -> dict:
         if not mu_s / 2 <= mu_k <= mu_s:
             raise ValueError(f"mu_k = {mu_k:g}: must be in [mu_s/2, mu_s] = [{mu_s / 2:g}, {mu_s:g}] "
                              f"so that 0 <= Fmin = (2 mu_k - mu_s) Fn <= mu_k Fn")
+    if "mu_k" in out and law == "static_dynamic":
+        if "mu_s" not in out:
+            raise ValueError("mu_k needs mu_s: the allowed range is [0, mu_s]")
+        if not out["mu_k"] <= out["mu_s"]:
+            raise ValueError(f"mu_k = {out['mu_k']:g}: must be in [0, mu_s] = [0, {out['mu_s']:g}] "
+                             f"(the dynamic limit is at most the static one)")
     return out
 
 
@@ -144,12 +156,16 @@ def rotate_history(D, n):
     return D * np.where(new > 0, scale, 1.0)[:, None]
 
 
-def tangential_force(D, V_s, fn, dt, p: LawParams, energy=False) -> TangentialStep:
+def tangential_force(D, V_s, fn, dt, p: LawParams, energy=False, sliding=None) -> TangentialStep:
     """One step of the tangential law for all contacts.
 
     D: spring elongation from the previous step, already in the tangent plane.
     energy: also return what the dashpot and the slips dissipated (docs/law.md, Energy).
+    sliding: static_dynamic's state of each contact from the previous step (None: all static);
+    its state after the step is `slipped` (a contact whose force was cut is sliding).
     """
+    if p.law == "static_dynamic":
+        return _static_dynamic(D, V_s, fn, dt, p, energy, np.zeros(len(fn), bool) if sliding is None else sliding)
     if p.law in ("coulomb", "visco_plastic"):
         F = _coulomb(V_s, fn, p) if p.law == "coulomb" else _visco_plastic(V_s, fn, p)
         e = -_dot(F, V_s) * dt if energy else None
@@ -334,6 +350,28 @@ def _plastic_flow(F, u, k_rest, T):
     cos, sin = (1.0 - s * s) / (1.0 + s * s), 2.0 * s / (1.0 + s * s)
     p_hat = np.divide(q, qn[:, None], out=np.zeros_like(q), where=qn[:, None] > 0)
     return (T * cos)[:, None] * u + (T * sin)[:, None] * p_hat
+
+
+def _static_dynamic(D, V_s, fn, dt, p, energy, sliding):
+    """The two-state static/dynamic law (docs/law.md, "Other tangential laws"; LAMMPS'
+    linear_history/static): steps 3-4 of the stick-slip law, then a Coulomb limit of
+    mu_s*Fn for a static contact and mu_k*Fn for a sliding one. A trial force above the
+    limit is cut to it, spring and dashpot together carrying it, and the contact is sliding
+    after the step (`slipped`); a trial force at or below it sticks, and the contact is static
+    again."""
+    D_start = D
+    D = D + V_s * dt  # eq. 7
+    F_t = -p.ks * D - p.nu_s * V_s  # eq. 5
+    mag = np.sqrt(_dot(F_t, F_t))
+    limit = np.where(sliding, p.mu_k, p.mu_s) * fn
+    over = mag > limit
+    F_s = F_t * np.where(over, limit / np.maximum(mag, 1e-300), 1.0)[:, None]
+    D = np.where(over[:, None], -(F_s + p.nu_s * V_s) / p.ks, D)
+    if not energy:
+        return TangentialStep(F_s, D, over, None, None)
+    total = -_dot(F_s, V_s) * dt - 0.5 * p.ks * (_dot(D, D) - _dot(D_start, D_start))
+    dashpot = p.nu_s * _dot(V_s, V_s) * dt * ~over
+    return TangentialStep(F_s, D, over, dashpot, total - dashpot)
 
 
 def _dot(a, b):

@@ -138,6 +138,7 @@ class Simulation:
         # Contact state, kept sorted by key = i*(N+W) + j, j = grain index or N + wall.
         self.keys = np.zeros(0, np.int64)
         self.D = np.zeros((0, 3))
+        self.sliding = np.zeros(0, bool)  # the static_dynamic law's state (p.has_state)
         self.pairs = None  # candidate pairs: (a, b, r_a + r_b), a < b
         self.x_at_build = None
         self._layout = None  # rows of the touching contacts (_make_layout)
@@ -322,21 +323,28 @@ class Simulation:
         V_s = v_rel - v_n[:, None] * n  # eq. 6
         fn = normal_force(delta, v_n, self.p)  # eq. 3
 
-        # Carry each contact's spring over from the last step; new contacts start at zero,
-        # ended contacts are dropped (their keys are simply not carried).
+        # Carry each contact's spring (and state) over from the last step; new contacts start
+        # at zero (static), ended contacts are dropped (their keys are simply not carried).
+        sliding = None
         if not self.p.has_spring:
             D = np.zeros((len(key), 3))
         elif key is self.keys or key.tobytes() == self.keys.tobytes():  # (np.array_equal, without its overhead)
             D = rotate_history(self.D, n)  # same contacts as last step (the usual case)
+            sliding = self.sliding if self.p.has_state else None
         else:
             D = np.zeros((len(key), 3))
+            sliding = np.zeros(len(key), bool) if self.p.has_state else None
             if len(self.keys) and len(key):
                 order = np.argsort(self.keys)
                 sorted_keys = self.keys[order]
                 pos = np.minimum(np.searchsorted(sorted_keys, key), len(sorted_keys) - 1)
                 old = sorted_keys[pos] == key
                 D[old] = rotate_history(self.D[order[pos[old]]], n[old])
-        tan = tangential_force(D, V_s, fn, dt, self.p, energy=self.energy)
+                if sliding is not None:
+                    sliding[old] = self.sliding[order[pos[old]]]
+        tan = tangential_force(D, V_s, fn, dt, self.p, energy=self.energy, sliding=sliding)
+        if self.p.has_state:
+            self.sliding = tan.slipped  # (static_dynamic: sliding after a step whose force was cut)
         F_s, D, slipped = tan.force, tan.spring, tan.slipped
         if self.slip_stats:
             self.vs_mag = np.sqrt(_dot(V_s, V_s))

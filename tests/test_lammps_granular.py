@@ -152,6 +152,58 @@ def test_unlike_types_mix_by_geometric_means(tmp_path):
     assert abs(np.linalg.norm(rows[31, 1:4]) - fmin) <= np.spacing(fmin), (rows[31], fmin)
 
 
+@pytest.mark.parametrize("timing, nu_s", [("step", 0.25), ("exact", 1.0)])
+def test_single_gives_the_force_the_law_would_apply_now(tmp_path, timing, nu_s):
+    """pair granular's single() without /record (compute pair/local p1-p3; LAMMPS' pair-style
+    tester cannot call it: it builds its atoms with atom_style full, which has no radius):
+    the force the law would apply with no time passing from the contact's spring and
+    velocity, -Ks D - nu_s V, dropped to Fmin along itself where it reaches mu_s Fn. A grain
+    pair in the contract's units (Fn = 1, Ks = 1, dt = 1/16), grain 1 sliding at 0.25 along y
+    for 40 steps, mu_s 0.5, mu_k 0.4: in step timing with nu_s 0.25 the spring loads, slips
+    and loads again (sticking and just-slipped states, no drop in single()); in exact timing
+    with nu_s 1 (nu_s |V| = 0.25 >= mu_s Fn - Fmin = 0.2) the contact slides after its first
+    slip (E4) with the spring holding Fmin + nu_s |V| > mu_s Fn, so single() drops it to Fmin.
+    The spring is pyref's after each step, single() pyref's law at dt = 0 in step timing.
+    Every value is a sum of multiples of 1/64 but for a drop's rescale, one rounding in each
+    (the same operations): 2 ulps of mu_s Fn allowed."""
+    import numpy as np
+
+    import lammps_runs
+    from pyref.laws import LawParams, tangential_force
+    from stickslip.contract import cases as lc
+    from stickslip.contract.lammps import LAMMPS_HEAD, _f, lammps_pair_local, lammps_pair_row
+
+    lmp = lammps_release_launcher(lammps_releases()[-1])
+    mu_s, mu_k, v, steps = 0.5, 0.4, 0.25, 40
+    model = lammps_granular.model_words(lc.KN, 1.0, lc.KS, nu_s, mu_s, mu_k, "spring", timing, record=False)
+    d = 2 * lc.R - lc.DELTA
+    lines = [LAMMPS_HEAD.format(ntypes=1, dt=_f(lc.DT)), "pair_style granular", f"pair_coeff * * {model}"]
+    for b, x in enumerate((-d / 2, d / 2)):
+        lines += [f"create_atoms 1 single {_f(x)} 0.0 0.0 units box",
+                  f"set atom {b + 1} diameter {_f(2 * lc.R)} density 1000 vx 0.0 vy {_f(v if b == 0 else 0.0)} vz 0.0"]
+    lines += ["variable zero equal 0.0", f"variable vy equal {_f(v)}", "group g1 id 1", "group g2 id 2",
+              "fix mv1 g1 move variable v_zero v_zero v_zero v_zero v_vy v_zero",
+              "fix mv2 g2 move variable v_zero v_zero v_zero v_zero v_zero v_zero"]
+    lines += lammps_pair_local((1, 2, 3)) + [f"run {steps}"]
+    lammps_runs.run_lammps(tmp_path, "single", "\n".join(lines) + "\n", exe=lmp)
+    pairs = lammps_runs.read_dump(tmp_path / "dump.pairs")
+    got = np.array([lammps_pair_row(pairs[s], 1, [0, 1, 2]) for s in range(1, steps + 1)])
+
+    law = dict(law="stick_slip", kn=lc.KN, nu_n=1.0, ks=lc.KS, nu_s=nu_s, mu_s=mu_s, mu_k=mu_k)
+    step, now = LawParams(**law, slip_timing=timing), LawParams(**law, slip_timing="step")
+    fn, V, D = np.array([lc.KN * lc.DELTA]), np.array([[0.0, v, 0.0]]), np.zeros((1, 3))
+    want, slipped, above = [], [], []
+    for _ in range(steps):
+        s = tangential_force(D, V, fn, lc.DT, step)
+        D = s.spring
+        slipped.append(bool(s.slipped[0]))
+        above.append(np.linalg.norm(-lc.KS * D[0] - nu_s * V[0]) >= mu_s * fn[0])  # single() drops it
+        want.append(tangential_force(D, V, fn, 0.0, now).force[0])
+    np.testing.assert_allclose(got, np.array(want), rtol=0, atol=2 * np.spacing(mu_s))
+    assert sum(slipped) >= 2 and not all(slipped)
+    assert sum(above) >= 20 if timing == "exact" else not any(above)
+
+
 @pytest.mark.parametrize("reset", ["stick_slip/record", "stick_slip/total/record"])
 def test_the_record_books_the_work_each_step(tmp_path, reset):
     """The record's dissipated work (the wall's column 14; docs/law.md "Energy": the work the

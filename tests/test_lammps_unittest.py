@@ -4,6 +4,7 @@ writes them, their values pyref's; the stock cases turned into the sub-model; an
 LAMMPS 4 Jul 2026 build has its test programs (STICKSLIP_SOURCE_BUILDS=lammps-2026; CI
 builds them), LAMMPS' granular tests, the turned cases and the sub-model's own, run."""
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -20,10 +21,13 @@ import lammps_unittest as lu  # noqa: E402
 @pytest.mark.parametrize("timing", sorted(lu.DRAG_FILES))
 def test_the_drag_cases_are_what_pyref_gives(timing):
     """The committed yaml is the tool's output from pyref's law (write it again with
-    `tools/lammps_unittest.py write`), and its segments end on steps that slip and on steps
-    that stick, before the first slip and over several cycles."""
+    `tools/lammps_unittest.py write`), with the date its values were generated as LAMMPS
+    writes it (ctime), and its segments end on steps that slip and on steps that stick,
+    before the first slip and over several cycles."""
     path = lu.CASES / "granular" / lu.DRAG_FILES[timing]
-    assert path.read_text() == lu.drag_case(timing)
+    date = lu.date_generated(path.read_text())
+    assert date is not None and time.strptime(date, "%a %b %d %H:%M:%S %Y")
+    assert path.read_text() == lu.drag_case(timing, date)
     ends = np.cumsum(lu.SEGMENTS)
     force, slipped = lu.drag_series(timing, ends[-1], slips=True)
     d = lu.DRAG
@@ -52,8 +56,9 @@ def test_the_pair_case_files_are_the_tools():
     """The pair granular case's input, data and skeleton are what the tool writes, and the
     committed case (reference values added by LAMMPS' tester) keeps the skeleton's settings."""
     styles = lu.CASES / "force-styles"
-    assert (styles / "in.granular").read_text() == lu.PAIR_INPUT
-    assert (styles / "data.granular").read_text() == lu.pair_data()
+    assert (styles / lu.PAIR_INPUT_FILE).read_text() == lu.PAIR_INPUT
+    assert (styles / lu.PAIR_DATA).read_text() == lu.pair_data()
+    assert lu.PAIR_DATA in lu.PAIR_INPUT and f"input_file: {lu.PAIR_INPUT_FILE}\n" in lu.pair_skeleton()
     assert (styles / lu.PAIR_SKELETON).read_text() == lu.pair_skeleton()
     case = (styles / lu.PAIR_CASE).read_text()
     for coeff in lu.PAIR_COEFFS:
@@ -84,7 +89,7 @@ def test_the_pair_case_slips_and_sticks(tmp_path):
     from lammps_runs import read_dump, run_lammps
 
     styles = lu.CASES / "force-styles"
-    (tmp_path / "data.granular").write_text((styles / "data.granular").read_text())
+    (tmp_path / lu.PAIR_DATA).write_text((styles / lu.PAIR_DATA).read_text())
     coeffs = [c.replace("stick_slip ", "stick_slip/record ").replace("stick_slip/total/exact ",
                                                                       "stick_slip/total/exact/record ")
               for c in lu.PAIR_COEFFS]

@@ -220,9 +220,9 @@ def test_contact_opening_while_sliding(timing, reset, nu_n, monkeypatch):
     springs_in = []
     real = pyref.solver.tangential_force
 
-    def recording(D, V_s, fn, dt, p, energy=False):
+    def recording(D, V_s, fn, dt, p, **options):
         springs_in.append(D.copy())
-        return real(D, V_s, fn, dt, p, energy=energy)
+        return real(D, V_s, fn, dt, p, **options)
 
     monkeypatch.setattr(pyref.solver, "tangential_force", recording)
     seen = {"fn_zero": 0, "landings": 0, "open_with_spring": 0}

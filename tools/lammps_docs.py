@@ -1,21 +1,22 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The patch's documentation built with LAMMPS' own tooling, against the page it changes.
+"""The patch's documentation built with LAMMPS' own tooling, against the pages it changes.
 
   tools/lammps_docs.py TREE PRISTINE [--venv DIR]
 
 TREE is a LAMMPS tree with tools/lammps_patch.py's patch applied (./run.sh setup's 4 Jul 2026
 tree, build/lammps_2026/source), PRISTINE the unpatched copies of the files the patch changes
-(build/lammps_2026/pristine). The page the patch changes, doc/src/pair_granular.rst, is
-built twice, as LAMMPS has it and as the patch leaves it, by LAMMPS' Sphinx configuration
-(doc/utils/sphinx-config/conf.py.in, configured as doc/Makefile does) and its extensions, in
-a source folder of that page, a Manual page whose toctree holds it, and a titled stub for
-each page it links to (the whole manual, 1000 pages and doxygen's API, is not read): the html
-builder and the spelling builder (`make html`, `make spelling`) with LAMMPS' own word list
-(the patched false_positives.txt). Every warning and every misspelt word of the patched page
-must be one of the unpatched page's: the patch adds none. Then LAMMPS' `make char_check`
-and `make role_check` rules on the patched page: ASCII only, roles written as LAMMPS writes
-them.
+(build/lammps_2026/pristine). The pages the patch changes (doc/src/pair_granular.rst, and
+granular_tangential_models.rst in a tree whose tangential models have a page of their own:
+tools/lammps_patch.py) are built twice, as LAMMPS has them and as the patch leaves them, by
+LAMMPS' Sphinx configuration (doc/utils/sphinx-config/conf.py.in, configured as doc/Makefile
+does) and its extensions, in a source folder of those pages, a Manual page whose toctree holds
+them, and a titled stub for each page they link to (the whole manual, 1000 pages and
+doxygen's API, is not read): the html builder and the spelling builder (`make html`, `make
+spelling`) with LAMMPS' own word list (the patched false_positives.txt). Every warning and
+every misspelt word of the patched pages must be one of the unpatched pages': the patch adds
+none. Then LAMMPS' `make char_check` and `make role_check` rules on the patched pages: ASCII
+only, roles written as LAMMPS writes them.
 
 The Python packages are LAMMPS' doc/utils/requirements.txt from PyPI, in a virtual
 environment of their own (--venv; ./run.sh setup makes build/lammps_docs/venv), with one
@@ -35,7 +36,9 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 VENV = REPO / "build" / "lammps_docs" / "venv"
-PAGE = "pair_granular"
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import lammps_patch  # noqa: E402
 
 
 def requirements(tree):
@@ -57,20 +60,22 @@ def configure(tree, out):
     return config
 
 
-def source_folder(page_text, words, out):
-    """The page, a Manual holding it, a stub for each page it links to, the word list."""
+def source_folder(pages, words, out):
+    """The pages ({name: text}), a Manual holding them, a stub for each page they link to,
+    the word list."""
     out.mkdir(parents=True)
-    (out / f"{PAGE}.rst").write_text(page_text)
-    linked = sorted(set(re.findall(r":doc:`(?:[^`<]*<)?([^`<>]+?)>?`", page_text, re.S)) - {PAGE})
+    for name, text in pages.items():
+        (out / f"{name}.rst").write_text(text)
+    linked = sorted(set(re.findall(r":doc:`(?:[^`<]*<)?([^`<>]+?)>?`", "".join(pages.values()), re.S)) - set(pages))
     for name in linked:
         (out / f"{name}.rst").write_text(f"{name}\n{'=' * len(name)}\n\nA stub of the page.\n")
-    toc = "\n".join(f"   {n}" for n in [PAGE] + linked)
+    toc = "\n".join(f"   {n}" for n in list(pages) + linked)
     (out / "Manual.rst").write_text(f"Manual\n======\n\n.. toctree::\n   :maxdepth: 1\n\n{toc}\n")
     (out / "false_positives.txt").write_text(words)
 
 
-def build(python, config, src, builder, out):
-    """One sphinx-build; returns its warnings about the page, line numbers left out (the patch
+def build(python, config, src, builder, out, pages):
+    """One sphinx-build; returns its warnings about the pages, line numbers left out (the patch
     moves them), and for the spelling builder the misspelt words."""
     log = out / f"{builder}.log"
     proc = subprocess.run([str(python), "-m", "sphinx", "-E", "-q", "-b", builder, "-c", str(config),
@@ -80,7 +85,7 @@ def build(python, config, src, builder, out):
         raise SystemExit(f"lammps_docs: sphinx-build -b {builder} failed:\n{proc.stderr[-3000:]}")
     found = set()
     for line in log.read_text().splitlines():
-        if f"{PAGE}.rst" in line:
+        if any(f"{name}.rst" in line for name in pages):
             found.add(re.sub(rf"{re.escape(str(src))}/|:\d+:", "", line).strip())
     if builder == "spelling":
         for f in (out / builder).rglob("*.spelling"):
@@ -103,26 +108,29 @@ def check(tree, pristine, venv=VENV):
     python = venv / "bin" / "python"
     if not python.is_file():
         return [f"lammps_docs: {python} missing (./run.sh setup with lammps-2026 makes it)"], False
-    patched = (tree / "doc" / "src" / f"{PAGE}.rst").read_text()
-    words = (tree / "doc" / "utils" / "sphinx-config" / "false_positives.txt").read_text()
-    original = (pristine / "doc" / "src" / f"{PAGE}.rst").read_text()
-    old_words = (pristine / "doc" / "utils" / "sphinx-config" / "false_positives.txt").read_text()
+    paths = [p for p in lammps_patch.changes(pristine) if p.endswith(".rst")]
+    spelling = lammps_patch.SPELLING
+    texts = {name: {Path(p).stem: (top / p).read_text() for p in paths} for name, top in
+             (("pristine", pristine), ("patched", tree))}
+    words = {"pristine": (pristine / spelling).read_text(), "patched": (tree / spelling).read_text()}
     lines, ok = [], True
+    shown = ", ".join(f"{Path(p).stem}.rst" for p in paths)
     with tempfile.TemporaryDirectory(prefix="lammps_docs-") as tmp:
         tmp = Path(tmp)
         config = configure(tree, tmp)
         found = {}
-        for name, text, w in (("pristine", original, old_words), ("patched", patched, words)):
-            source_folder(text, w, tmp / name / "src")
-            found[name] = {b: build(python, config, tmp / name / "src", b, tmp / name) for b in ("html", "spelling")}
+        for name in ("pristine", "patched"):
+            source_folder(texts[name], words[name], tmp / name / "src")
+            found[name] = {b: build(python, config, tmp / name / "src", b, tmp / name, texts[name])
+                           for b in ("html", "spelling")}
         for b in ("html", "spelling"):
             new = found["patched"][b] - found["pristine"][b]
-            lines.append(f"make {b} on {PAGE}.rst: {len(found['patched'][b])} warnings with the patch, "
+            lines.append(f"make {b} on {shown}: {len(found['patched'][b])} warnings with the patch, "
                          f"{len(found['pristine'][b])} without; new: {len(new)}")
             lines += [f"  {x}" for x in sorted(new)]
             ok &= not new
-    bad = ascii_and_roles(patched)
-    lines.append(f"char_check and role_check on {PAGE}.rst: {len(bad)} lines")
+    bad = [x for text in texts["patched"].values() for x in ascii_and_roles(text)]
+    lines.append(f"char_check and role_check on {shown}: {len(bad)} lines")
     lines += [f"  {x}" for x in bad]
     return lines, ok and not bad
 

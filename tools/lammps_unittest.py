@@ -4,6 +4,7 @@
 `STICKSLIP_SOURCE_BUILDS=lammps-2026 ./run.sh setup`, configured with ENABLE_TESTING):
 
   tools/lammps_unittest.py write        the sub-model's yaml cases in lammps_plugin/unittest/ again
+                                        (a case whose values are unchanged keeps its date_generated)
   tools/lammps_unittest.py generate     the pair case's reference values (test_pair_style -g)
   tools/lammps_unittest.py run [BUILD]  LAMMPS' granular tests, their linear_history and mindlin
                                         cases with stick_slip/total instead, and the sub-model's own
@@ -20,7 +21,10 @@ What runs (counts printed at the end):
   constant speed, its torque (the wall's tangential force times the radius) a saw-tooth
   whose values are pyref's law's (write_drag_case), in step and exact timing; and a pair
   granular case for LAMMPS' pair-style tester (test_pair_style: newton on and off, restart,
-  data file), its forces generated once by that tester and then checked.
+  data file), its forces generated once by that tester and then checked. Its single() test is
+  skipped: the tester builds the two atoms of single() with atom_style full (or ellipsoid),
+  which carries no radius, and pair granular refuses an atom style without one; the
+  sub-model's single() is tested by tests/test_lammps_granular.py through compute pair/local.
 """
 from __future__ import annotations
 
@@ -29,6 +33,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -77,11 +82,12 @@ def _rows(values):
     return "".join(f"  {i:3d} {1:3d} {a:23.16e} {b:23.16e} {c:23.16e}\n" for i, (a, b, c) in enumerate(values))
 
 
-def drag_case(timing):
+def drag_case(timing, date):
     """The yaml case of unittest/granular (driver test_dem_04, sliding) for the drag in one
     slip timing: positions, velocities, torques and angular velocities at the end of each
     segment, computed as LAMMPS' velocity Verlet moves the sphere (x gains dt V a step) and
-    pyref's law gives the wall's tangential force F (torque -R n x F, n = +z)."""
+    pyref's law gives the wall's tangential force F (torque -R n x F, n = +z); `date`: when
+    its values were generated (date_generated, as LAMMPS' yaml cases give it)."""
     d = DRAG
     name = "stick_slip" + ("/exact" if timing == "exact" else "")
     ends = np.cumsum(SEGMENTS)
@@ -101,6 +107,7 @@ def drag_case(timing):
     return f"""---
 lammps_version: 4 Jul 2026
 tags: granular
+date_generated: {date}
 epsilon: {1e-13 if timing == "step" else 1e-12}
 skip_tests:
 prerequisites: ! |
@@ -152,31 +159,33 @@ PAIR_COEFFS = (
     "1 2 hooke 1000 20 damping velocity tangential stick_slip/total/exact 800 0.5 0.2 0.12",
 )
 SPACING, CELLS = 0.9, 4
+# the pair case's input and data files, named for it in LAMMPS' folder of force-style inputs
+PAIR_INPUT_FILE, PAIR_DATA = "in.granular_stick_slip", "data.granular_stick_slip"
 
-PAIR_INPUT = """# pair granular on 64 overlapping spheres (data.granular), for test_pair_style
+PAIR_INPUT = f"""# pair granular on 64 overlapping spheres ({PAIR_DATA}), for test_pair_style
 variable  newton_pair index  on
 variable  units       index  lj
 variable  input_dir   index  .
-variable  data_file   index  ${input_dir}/data.granular
+variable  data_file   index  ${{input_dir}}/{PAIR_DATA}
 variable  pair_style  index  granular
 
 atom_style      sphere
 atom_modify     map array
-units           ${units}
+units           ${{units}}
 boundary        p p p
-newton          ${newton_pair}
+newton          ${{newton_pair}}
 comm_modify     vel yes
 neighbor        0.3 bin
 neigh_modify    delay 0 every 1 check yes
 timestep        0.001
 
-pair_style      ${pair_style}
-read_data       ${data_file}
+pair_style      ${{pair_style}}
+read_data       ${{data_file}}
 """
 
 
 def pair_data(seed=20260704):
-    """data.granular: the spheres' types, diameters, densities, positions, velocities and spins."""
+    """The pair case's data file: the spheres' types, diameters, densities, positions, velocities and spins."""
     rng = np.random.default_rng(seed)
     n = CELLS ** 3
     side = SPACING * CELLS
@@ -212,7 +221,7 @@ prerequisites: ! |
 pre_commands: ! ""
 post_commands: ! |
   pair_style granular
-input_file: in.granular
+input_file: {PAIR_INPUT_FILE}
 pair_style: granular
 pair_coeff: ! |
 {coeffs}extract: ! ""
@@ -228,12 +237,23 @@ PAIR_CASE = "atomic-pair-granular_stick_slip.yaml"
 DRAG_FILES = {"step": "dem04-stick-slip-drag-3d.yaml", "exact": "dem04-stick-slip-exact-drag-3d.yaml"}
 
 
+def date_generated(case):
+    """A yaml case's date_generated (None without one)."""
+    m = re.search(r"^date_generated: (.+)$", case, re.M)
+    return m[1] if m else None
+
+
 def write():
     """The drag's yaml cases, and the pair case's input, data and skeleton (its reference
     values: `generate`)."""
-    files = {CASES / "granular" / name: drag_case(timing) for timing, name in DRAG_FILES.items()}
+    files = {}
+    for timing, name in DRAG_FILES.items():
+        path = CASES / "granular" / name
+        old = path.read_text() if path.is_file() else ""
+        same = drag_case(timing, date_generated(old)) if old else None
+        files[path] = same if same == old else drag_case(timing, time.ctime())  # (as LAMMPS writes it)
     styles = CASES / "force-styles"
-    files.update({styles / "in.granular": PAIR_INPUT, styles / "data.granular": pair_data(),
+    files.update({styles / PAIR_INPUT_FILE: PAIR_INPUT, styles / PAIR_DATA: pair_data(),
                   styles / PAIR_SKELETON: pair_skeleton()})
     for path, text in files.items():
         path.parent.mkdir(parents=True, exist_ok=True)

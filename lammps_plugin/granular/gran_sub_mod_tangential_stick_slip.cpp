@@ -34,11 +34,17 @@
 using namespace LAMMPS_NS;
 using namespace Granular_NS;
 using namespace MathExtra;
-using stickslip::StickSlipCore;    // (the law's core; tools/lammps_patch.py puts it in LAMMPS_NS)
+using stickslip::StickSlipCore;    // (the law's core; tools/lammps_patch.py puts it in Granular_NS)
 
 // as linear_history and mindlin: the spring is turned into the tangent plane only when its
 // normal part carries more than EPSILON of the threshold
 static constexpr double EPSILON = 1e-10;
+// exact timing: a contact whose bound |F| + Ks dt |V_s| on the step's trial force (at both
+// ends) is below the threshold by more than this share of it sticks without the step's start
+// force; the bound takes a dozen rounded operations and GranularModel's |V_s| (vrel) a few
+// more, each within 1.1e-16 of its value: the margin, ~90 such roundings, keeps round-off
+// from hiding a slip
+static constexpr double STICK_MARGIN = 1e-14;
 
 static const char cite_stick_slip[] =
     "tangential stick_slip: doi:10.15587/2706-5448.2024.310428\n\n"
@@ -49,7 +55,8 @@ static const char cite_stick_slip[] =
     " year =    {2024},\n"
     " volume =  {4},\n"
     " number =  {1(78)},\n"
-    " pages =   {17--25}\n"
+    " pages =   {17--25},\n"
+    " doi =     {10.15587/2706-5448.2024.310428}\n"
     "}\n\n";
 
 /* ----------------------------------------------------------------------
@@ -58,8 +65,9 @@ static const char cite_stick_slip[] =
    turns a vector into the tangent plane with GranSubMod::rotate_rescale_vec, and its stock
    sub-models rescale a force by Fscrit / |F|. LAMMPS 4 Feb 2025 has none of these, writes
    the same turn out in each sub-model, and rescales by Fscrit * (1 / |F|). These helpers ask
-   the host which it is, so that at mu_k = mu_s the sub-model is that release's
-   linear_history (mindlin) to the last bit, and follows a later release's helper.
+   the host which it is, so that at mu_k = mu_s the sub-model does that release's
+   linear_history (mindlin) arithmetic, and follows a later release's helper. (LAMMPS' own
+   tree takes the sub-model with the current members used directly: tools/lammps_form.py.)
 ------------------------------------------------------------------------- */
 
 namespace {
@@ -300,10 +308,10 @@ template <int OPTIONS> void GranSubModTangentialStickSlip::forces()
   int slipped = 0;
   if constexpr (exact_timing) {
     // most contacts stick through the step: |F| + Ks dt |V_s| bounds the trial force at both
-    // of its ends (|V_s| is the host's vrel), so below the threshold by more than round-off
+    // of its ends (|V_s| is GranularModel's vrel), so below the threshold by more than round-off
     // no slip happens and E0 need not build the step's start force
     const double dt = update ? gm->dt : 0.0, mag2 = lensq3(F);
-    if (!(sqrt(mag2) + ks * dt * gm->vrel < Fscrit * (1.0 - 1e-14))) {
+    if (!(sqrt(mag2) + ks * dt * gm->vrel < Fscrit * (1.0 - STICK_MARGIN))) {
       double stick;
       slipped =
           StickSlipCore::exact_step(StickSlipCore::slips(mag2, Fscrit * Fscrit), F, D, v, ks, damp,
@@ -349,7 +357,7 @@ void GranSubModTangentialStickSlip::calculate_forces()
 }
 
 // each variant compiled with its options as constants, so that a contact's force tests none of
-// them (a contact-step that reads them at run time takes more instructions: docs/performance.md)
+// them (read at run time, they cost a flowing bed 3 % more instructions per step)
 void GranSubModStickSlipRecord::calculate_forces()
 {
   forces<RECORD>();

@@ -29,91 +29,89 @@ GranSubModStyle(stick_slip/total/exact/record,GranSubModStickSlipTotalExactRecor
 
 #include "gran_sub_mod_tangential.h"
 
-namespace LAMMPS_NS {
-namespace Granular_NS {
+namespace LAMMPS_NS::Granular_NS {
 
-  class GranSubModTangentialStickSlip : public GranSubModTangential {
-   public:
-    // options of the style's name: /total, /exact, /record
-    enum { TOTAL = 1, EXACT = 2, RECORD = 4 };
+class GranSubModTangentialStickSlip : public GranSubModTangential {
+ public:
+  // options of the style's name: /total, /exact, /record
+  enum { TOTAL = 1, EXACT = 2, RECORD = 4 };
 
-    GranSubModTangentialStickSlip(class GranularModel *, class LAMMPS *, int options = 0);
-    void coeffs_to_local() override;
-    void mix_coeffs(double *, double *) override;
-    void calculate_forces() override;
+  GranSubModTangentialStickSlip(class GranularModel *, class LAMMPS *, int options = 0);
+  void coeffs_to_local() override;
+  void mix_coeffs(double *, double *) override;
+  void calculate_forces() override;
 
-    // history: the spring (3 values), then with /record the last normal force, the last
-    // tangential force (3 values), the number of slips and the dissipated work
-    enum { HIST_FN = 3, HIST_FS = 4, HIST_NSLIP = 7, HIST_WORK = 8, SIZE_RECORD = 9 };
+  // history: the spring (3 values), then with /record the last normal force, the last
+  // tangential force (3 values), the number of slips and the dissipated work
+  enum { HIST_FN = 3, HIST_FS = 4, HIST_NSLIP = 7, HIST_WORK = 8, SIZE_RECORD = 9 };
 
-   protected:
-    int reset_total, exact_timing, record;
-    int mindlin;     // Ks given as NULL: k is Mindlin's stiffness per unit contact radius
-    double xt;       // tangential damping as a multiple of the damping prefactor
-    double kin;      // 2 mu_k - mu_s: the force after a slip is kin Fn
-    double ratio;    // kin / mu_s
+ protected:
+  int reset_total, exact_timing, record;
+  int mindlin;     // Ks given as NULL: k is Mindlin's stiffness per unit contact radius
+  double xt;       // tangential damping as a multiple of the damping prefactor
+  double kin;      // 2 mu_k - mu_s: the force after a slip is kin Fn
+  double ratio;    // kin / mu_s
 
-    void report_record(const double *);
-    // the force for one contact, the options as compile-time constants (each variant's
-    // calculate_forces)
-    template <int OPTIONS> void forces();
-  };
+  void report_record(const double *);
+  // the force for one contact, the options as compile-time constants (each variant's
+  // calculate_forces)
+  template <int OPTIONS> void forces();
+};
 
-  /* ----------------------------------------------------------------------
+/* ----------------------------------------------------------------------
      the variants of the style's name (their names leave out "Tangential", for 100 columns)
   ------------------------------------------------------------------------- */
 
-  class GranSubModStickSlipRecord : public GranSubModTangentialStickSlip {
-   public:
-    GranSubModStickSlipRecord(class GranularModel *gm, class LAMMPS *lmp) :
-        GranSubModTangentialStickSlip(gm, lmp, RECORD){};
-    void calculate_forces() override;
-  };
+class GranSubModStickSlipRecord : public GranSubModTangentialStickSlip {
+ public:
+  GranSubModStickSlipRecord(class GranularModel *gm, class LAMMPS *lmp) :
+      GranSubModTangentialStickSlip(gm, lmp, RECORD){};
+  void calculate_forces() override;
+};
 
-  class GranSubModStickSlipExact : public GranSubModTangentialStickSlip {
-   public:
-    GranSubModStickSlipExact(class GranularModel *gm, class LAMMPS *lmp) :
-        GranSubModTangentialStickSlip(gm, lmp, EXACT){};
-    void calculate_forces() override;
-  };
+class GranSubModStickSlipExact : public GranSubModTangentialStickSlip {
+ public:
+  GranSubModStickSlipExact(class GranularModel *gm, class LAMMPS *lmp) :
+      GranSubModTangentialStickSlip(gm, lmp, EXACT){};
+  void calculate_forces() override;
+};
 
-  class GranSubModStickSlipExactRecord : public GranSubModTangentialStickSlip {
-   public:
-    GranSubModStickSlipExactRecord(class GranularModel *gm, class LAMMPS *lmp) :
-        GranSubModTangentialStickSlip(gm, lmp, EXACT | RECORD){};
-    void calculate_forces() override;
-  };
+class GranSubModStickSlipExactRecord : public GranSubModTangentialStickSlip {
+ public:
+  GranSubModStickSlipExactRecord(class GranularModel *gm, class LAMMPS *lmp) :
+      GranSubModTangentialStickSlip(gm, lmp, EXACT | RECORD){};
+  void calculate_forces() override;
+};
 
-  class GranSubModStickSlipTotal : public GranSubModTangentialStickSlip {
-   public:
-    GranSubModStickSlipTotal(class GranularModel *gm, class LAMMPS *lmp) :
-        GranSubModTangentialStickSlip(gm, lmp, TOTAL){};
-    void calculate_forces() override;
-  };
+class GranSubModStickSlipTotal : public GranSubModTangentialStickSlip {
+ public:
+  GranSubModStickSlipTotal(class GranularModel *gm, class LAMMPS *lmp) :
+      GranSubModTangentialStickSlip(gm, lmp, TOTAL){};
+  void calculate_forces() override;
+};
 
-  class GranSubModStickSlipTotalRecord : public GranSubModTangentialStickSlip {
-   public:
-    GranSubModStickSlipTotalRecord(class GranularModel *gm, class LAMMPS *lmp) :
-        GranSubModTangentialStickSlip(gm, lmp, TOTAL | RECORD){};
-    void calculate_forces() override;
-  };
+class GranSubModStickSlipTotalRecord : public GranSubModTangentialStickSlip {
+ public:
+  GranSubModStickSlipTotalRecord(class GranularModel *gm, class LAMMPS *lmp) :
+      GranSubModTangentialStickSlip(gm, lmp, TOTAL | RECORD){};
+  void calculate_forces() override;
+};
 
-  class GranSubModStickSlipTotalExact : public GranSubModTangentialStickSlip {
-   public:
-    GranSubModStickSlipTotalExact(class GranularModel *gm, class LAMMPS *lmp) :
-        GranSubModTangentialStickSlip(gm, lmp, TOTAL | EXACT){};
-    void calculate_forces() override;
-  };
+class GranSubModStickSlipTotalExact : public GranSubModTangentialStickSlip {
+ public:
+  GranSubModStickSlipTotalExact(class GranularModel *gm, class LAMMPS *lmp) :
+      GranSubModTangentialStickSlip(gm, lmp, TOTAL | EXACT){};
+  void calculate_forces() override;
+};
 
-  class GranSubModStickSlipTotalExactRecord : public GranSubModTangentialStickSlip {
-   public:
-    GranSubModStickSlipTotalExactRecord(class GranularModel *gm, class LAMMPS *lmp) :
-        GranSubModTangentialStickSlip(gm, lmp, TOTAL | EXACT | RECORD){};
-    void calculate_forces() override;
-  };
+class GranSubModStickSlipTotalExactRecord : public GranSubModTangentialStickSlip {
+ public:
+  GranSubModStickSlipTotalExactRecord(class GranularModel *gm, class LAMMPS *lmp) :
+      GranSubModTangentialStickSlip(gm, lmp, TOTAL | EXACT | RECORD){};
+  void calculate_forces() override;
+};
 
-}    // namespace Granular_NS
-}    // namespace LAMMPS_NS
+}    // namespace LAMMPS_NS::Granular_NS
 
 #endif
 #endif

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pyref.laws import LAWS, RESETS, SLIP_TIMINGS, LawParams
+from pyref.laws import LAWS, RESETS, SLIP_TIMINGS, SPRING_LAWS, LawParams
 
 from .. import columns, kinds, shipped
 from ..errors import SceneError
@@ -288,7 +288,7 @@ def _apply_overrides(data, overrides):
 
 def _contact(ct) -> Contact:
     law = ct.string("law", "stick_slip", LAWS)
-    spring = law in ("stick_slip", "visco_elastic")
+    spring = law in SPRING_LAWS
     contact = Contact(
         law=law,
         kn=ct.number("kn", required=True),

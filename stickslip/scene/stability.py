@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+from pyref.laws import SPRING_LAWS
+
 # An impact must last at least this many steps (T_c = pi/w >= 5 dt). With fewer, an
 # explicit step can give back more energy than the contact took: measured for an
 # undamped grain-wall impact over 40 entry phases, the restitution reaches 1.02 at
@@ -49,7 +51,7 @@ def stability_limits(scene) -> dict:
     nu_s = c.nu_s if eff["tangential_damping"] else 0.0
     limits = {"normal": _oscillator_limit(c.kn, nu_n, m_eff),
               "impact": _ratio(math.pi, math.sqrt(c.kn / m_eff) * IMPACT_STEPS)}
-    if c.law in ("stick_slip", "visco_elastic"):
+    if c.law in SPRING_LAWS:
         limits["tangential"] = _oscillator_limit(c.ks, nu_s, m_eff / turn)
     elif nu_s > 0:
         # A pure dashpot (visco-plastic, Coulomb's regularisation) is explicitly stable for dt < 2 m / nu_s.
