@@ -7,7 +7,7 @@
    Built two ways from this one file: as a plugin against the installed Debian headers
    (CMakeLists.txt, which registers the model itself), or dropped alone into LIGGGHTS'
    src/ and built with `make auto`, whose style scan registers it as LIGGGHTS' own
-   tangential models (doc/tangential_model_stick_slip.md, "Build into LIGGGHTS"). */
+   tangential models (README.md, "Build into LIGGGHTS"). */
 
 #ifdef TANGENTIAL_MODEL
 // id 23: unused by LIGGGHTS 3.8 (off 0, no_history 1, history 2, tan_luding 4); ids must be < 64

@@ -651,16 +651,23 @@ def test_the_readmes_costs_are_the_current_figures():
 
 
 def test_yades_current_range_is_its_rows_over_both_runs():
-    """performance.md's current YADE cell gives the ratio's range over the History's two idle
-    runs of the same row (rotation on; rotation on, exact timing), not over other rows."""
+    """performance.md's current YADE cells give each law's time ratio as the range over the
+    History's two runs of the same law and timing (and the compiled law's instructions as
+    counted there), not over other rows."""
     performance = (ROOT / "docs/performance.md").read_text()
-    history = table_rows(section(performance, "### YADE"), "| case | native | stick-slip | ratio |")
-    runs = {r[0]: sorted(float(x) for x in r[3:5]) for r in history if r[3] and r[4]}
-    yade = next(r for r in table_rows(section(performance, "## Current figures"), "| engine | benchmark |")
-                if r[0].startswith("YADE"))
-    for cell, case in ((yade[3], "rotation on"), (yade[4], 'rotation on, `slip_timing="exact"`')):
-        lo, hi = runs[case]
-        assert f"({lo:.2f}-{hi:.2f} in two runs)" in cell, (cell, case, lo, hi)
+    history = table_rows(section(performance, "### YADE"), "| law, timing |")
+    first = lambda cell: float(re.match(r"\d+\.\d+", cell).group(0))
+    runs = {r[0]: sorted((first(r[2]), first(r[3]))) for r in history}
+    current = [r for r in table_rows(section(performance, "## Current figures"), "| engine | benchmark |")
+               if r[0].startswith("YADE")]
+    assert [r[0] for r in current] == ["YADE 2023.02a, the compiled law", "YADE 2023.02a, the Python law"]
+    for row, law in zip(current, ("the compiled law", "the Python law")):
+        for cell, timing in ((row[3], "step timing"), (row[4], "exact timing")):
+            lo, hi = runs[f"{law}, {timing}"]
+            assert f"time {lo:.3f}-{hi:.3f} in two runs" in cell, (cell, law, timing, lo, hi)
+    for cell, timing in ((current[0][3], "step timing"), (current[0][4], "exact timing")):
+        counted = next(r[4] for r in history if r[0] == f"the compiled law, {timing}")
+        assert f"instructions {counted.split()[-1]}" in cell, (cell, counted)
 
 
 def test_history_calls_no_figure_current():

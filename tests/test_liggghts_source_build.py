@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """`tangential stick_slip` built into LIGGGHTS-PUBLIC 3.8 the LIGGGHTS way (the law's two headers
-copied into src/, then `make auto`: liggghts_plugin/doc/tangential_model_stick_slip.md,
+copied into src/, then `make auto`: liggghts_plugin/README.md,
 "Build into LIGGGHTS"; `STICKSLIP_SOURCE_BUILDS=liggghts-public ./run.sh setup` builds it
 into build/liggghts_public/source/src/lmp_auto) must give the plugin's answers
 (build/liggghts_plugin/liggghts-stickslip, against Debian's library) on the same input, to

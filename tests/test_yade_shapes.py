@@ -72,6 +72,20 @@ elif scene == "periodic":  # two spheres touching across the x boundary of the c
     held(utils.sphere((0.005, 0.05, 0.05), R, material=mat))
     moving = held(utils.sphere((0.1 - 0.015 + DELTA, 0.05, 0.05), R, material=mat))
     plan = [(300, (0.0, 0.02, -0.01)), (400, (0.0, -0.02, 0.005))]
+elif scene == "periodic_sheared":  # the same pair in a sheared cell (v_y = 0.2 x): its image moves
+    O.periodic = True
+    O.cell.setBox(0.1, 0.1, 0.1)
+    O.cell.velGrad = Matrix3(0, 0, 0, 0.2, 0, 0, 0, 0, 0)
+    held(utils.sphere((0.005, 0.05, 0.05), R, material=mat))
+    moving = held(utils.sphere((0.1 - 0.015 + DELTA, 0.05, 0.05), R, material=mat))
+    plan = [(300, (0.0, 0.02, -0.01)), (400, (0.0, -0.02, 0.005))]
+elif scene == "periodic_facet":  # a sphere on a facet through its image across z, the cell sheared (v_x = 0.2 z)
+    O.periodic = True
+    O.cell.setBox(0.1, 0.1, 0.1)
+    O.cell.velGrad = Matrix3(0, 0, 0.2, 0, 0, 0, 0, 0, 0)
+    O.bodies.append(utils.facet([(0.02, 0.02, 0.095), (0.08, 0.02, 0.095), (0.05, 0.08, 0.095)], material=mat))
+    moving = held(utils.sphere((0.05, 0.04, 0.095 + R - DELTA - 0.1), R, material=mat))
+    plan = [(300, (0.01, 0.005, 0.0)), (400, (-0.01, -0.0025, 0.0))]
 elif scene == "clump":  # a clump of two spheres dragged and turned on a facet
     O.bodies.append(utils.facet([(-0.2, -0.2, 0), (0.2, -0.2, 0), (0, 0.3, 0)], material=mat))
     moving, _ = O.bodies.appendClumped([utils.sphere((-0.008, 0, R - DELTA), R, material=mat),
@@ -159,7 +173,14 @@ def longest_stick(flags):
 
 
 SCENES = ["spheres", "spheres_rolling", "facet", "facet_translating", "facet_rotating", "facet_rolling", "periodic",
+          "periodic_sheared", "periodic_facet",
           "clump"]
+# The scenes YADE's native law is a reference for: in a cell that deforms, YADE 2023.02a's
+# Law2_ScGeom_ViscElPhys_Basic adds the image's shift velocity with the wrong sign
+# (yade_law/README.md), so its shear spring there loads with 2 shiftVel too much or too
+# little; the law's V_s in a sheared cell is held by
+# test_periodic_homogeneous_shear_loads_the_spring_with_the_image_motion instead.
+NATIVE_SCENES = [s for s in SCENES if s not in ("periodic_sheared", "periodic_facet")]
 
 
 def scene_runs(modes, launcher="yade"):
@@ -169,7 +190,7 @@ def scene_runs(modes, launcher="yade"):
     return {(s, m): runs[json.dumps({"mode": m, "scene": s}, sort_keys=True)] for s in SCENES for m in modes}
 
 
-@pytest.mark.parametrize("scene", SCENES)
+@pytest.mark.parametrize("scene", NATIVE_SCENES)
 def test_reproduces_native_cundall_strack(scene):
     runs = scene_runs(("native", "law"))
     like_native(scene, runs[scene, "native"], runs[scene, "law"])

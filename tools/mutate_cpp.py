@@ -372,7 +372,7 @@ YADE_CPP_MUTANTS = (
     Mutant("yade_wall_point_centre", "a wall's velocity taken at its centre, not at its surface",
            "a1 = (s2.pos + shift2 - (r2 - delta) * n) - s1.pos;", "a1 = Vector3r::Zero();"),
     Mutant("yade_shift_velocity_sign", "the periodic image's velocity with the wrong sign",
-           "Vector3r vrel = s1.vel - s2.vel - shiftVel;", "Vector3r vrel = s1.vel - s2.vel + shiftVel;"),
+           "vrel = s1.vel - s2.vel - shiftVel;", "vrel = s1.vel - s2.vel + shiftVel;"),
     Mutant("yade_spring_kept_at_zero_overlap", "a contact at zero overlap keeps its spring",
            "D = F = Vector3r::Zero();", "F = Vector3r::Zero();"),
     Mutant("yade_slip_counted_twice", "a wrong slip count in the record", "phys.slips++;", "phys.slips += 2;"),

@@ -2,7 +2,8 @@
 """The law's contract on YADE's compiled law (runners.py): each case as a YADE script with the
 law's engines and no integrator (the bodies stay where the script puts them before each step),
 run by the compiled law's launcher, read back from the contact's own record (StickSlipPhys:
-the spring, the normal force, the force, the slip count)."""
+the spring, the normal force, the force, the slip count) and, beside the contract, from the
+energy books the law keeps (trace["books"])."""
 from __future__ import annotations
 
 import json
@@ -24,6 +25,7 @@ from yade import utils
 def run(case):
   O.reset()
   O.dt = case["dt"]
+  O.trackEnergy = True  # the books the law keeps (docs/law.md, Energy), read at each step
   mat = O.materials.append(ViscElMat(kn=2 * case["kn"], cn=2 * case["nu_n"], ks=0.0, cs=0.0, frictionAngle=0.0,
                                      density=1000.0))
   if case["geometry"] == "wall":  # the floor z = 0 (id 0, the first of its interactions), grain i above it
@@ -48,8 +50,10 @@ def run(case):
       p, g = I.phys, I.geom
       # the record is body 1's; grain i is body 1 of a pair, body 2 on the wall (YADE puts the wall first)
       sign = 1.0 if I.id1 == i else -1.0
+      books = dict(O.energy.items())
       rows.append({"fn": max(0.0, p.Fn + p.Fv), "F": [-sign * c for c in p.shearForce],
-                   "D": [sign * c for c in p.spring], "slips": p.slips, "n": [sign * c for c in g.normal]})
+                   "D": [sign * c for c in p.spring], "slips": p.slips, "n": [sign * c for c in g.normal],
+                   "books": [books["stickslip_slip"], books["stickslip_dashpot"], books["stickslip_spring"]]})
   return rows
 
 
@@ -85,11 +89,12 @@ def run_cases(cases):
     traces = []
     for case, rows in zip(cases, json.loads(lines[-1][7:])):
         out = lc.empty_trace(case.steps)
+        out["books"] = np.full((case.steps, 3), np.nan)  # O.energy's slip, dashpot and spring entries
         for k, row in enumerate(rows):
             if row is None:
                 continue
             out["fn"][k], out["F"][k], out["D"][k] = row["fn"], np.array(row["F"]), np.array(row["D"])
-            out["slips"][k], out["n"][k] = row["slips"], np.array(row["n"])
+            out["slips"][k], out["n"][k], out["books"][k] = row["slips"], np.array(row["n"]), row["books"]
         traces.append(out)
     return traces
 

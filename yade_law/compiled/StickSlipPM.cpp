@@ -395,4 +395,13 @@ Real Law2_ScGeom_StickSlipPhys_StickSlip::layoutEnergy(const boost::python::obje
 	return id < 0 ? Real(NAN) : s->energy->energies.get(id);
 }
 
+bool Law2_ScGeom_StickSlipPhys_StickSlip::asPlugin()
+{
+#ifdef STICKSLIP_YADE_PLUGIN
+	return true; // yade_law/compiled/CMakeLists.txt: YADE 2025.2.0's headers, Debian's YADE's libraries
+#else
+	return false; // compiled into YADE from its own source: its headers are its own
+#endif
+}
+
 } // namespace yade

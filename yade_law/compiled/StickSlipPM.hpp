@@ -79,6 +79,7 @@ public:
 	static boost::python::dict layoutProbe(const shared_ptr<Interaction>& I, const shared_ptr<Body>& b, const boost::python::object& scene);
 	static void                layoutAdd(const boost::python::object& scene, long id, const Vector3r& f, const Vector3r& t);
 	static Real                layoutEnergy(const boost::python::object& scene, const std::string& name);
+	static bool                asPlugin(); // built as a plugin for another YADE (the layout check applies)
 	// clang-format off
 	YADE_CLASS_BASE_DOC_ATTRS_CTOR_PY(Law2_ScGeom_StickSlipPhys_StickSlip,LawFunctor,"The stick-slip friction law of Khellaf & Mansouri (2024) (docs/law.md): YADE's ViscEl normal force (eq. 3), a tangential spring and dashpot (eq. 5) in series with a slider that slips at mu_s Fn and drops to Fmin = (2 mu_k - mu_s) Fn (eq. 8).",
 		((std::string,reset,"spring",Attr::triggerPostLoad,"At a slip the spring alone carries Fmin ('spring', eq. 8) or spring and dashpot together ('total')."))
@@ -101,6 +102,7 @@ public:
 		.def("layoutProbe",&Law2_ScGeom_StickSlipPhys_StickSlip::layoutProbe,"(for the layout check) the members of an interaction, a body and the scene as this plugin reads them").staticmethod("layoutProbe")
 		.def("layoutAdd",&Law2_ScGeom_StickSlipPhys_StickSlip::layoutAdd,"(for the layout check) a force and a torque added to a body through this plugin").staticmethod("layoutAdd")
 		.def("layoutEnergy",&Law2_ScGeom_StickSlipPhys_StickSlip::layoutEnergy,"(for the layout check) an O.energy entry as this plugin reads it").staticmethod("layoutEnergy")
+		.def("asPlugin",&Law2_ScGeom_StickSlipPhys_StickSlip::asPlugin,"True if built as a plugin against another YADE's headers (yade_law/compiled/CMakeLists.txt), False if compiled into YADE with its own sources").staticmethod("asPlugin")
 	);
 	// clang-format on
 	FUNCTOR2D(ScGeom, StickSlipPhys);

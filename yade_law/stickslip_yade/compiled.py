@@ -5,7 +5,8 @@ view of its contacts with the Python law's queries (contact, lookup, has_slipped
 The plugin is loaded when YADE starts through the launcher build/yade_law/yade-stickslip (a
 private YADE_PREFIX holding Debian's YADE and the plugin), which first checks that the plugin
 reads YADE's classes where this YADE keeps them (yade_law/compiled/layout_check.py). A script
-started otherwise gets one line saying how to start it.
+started otherwise gets one line saying how to start it. A YADE built from source with the law's
+files in its pkg/dem/ has the classes itself, with its own headers: no prefix, no check.
 """
 import importlib.util
 import os
@@ -28,6 +29,10 @@ def require():
     if not loaded():
         raise RuntimeError(f"backend = 'cpp': the compiled law is not loaded in this YADE; start YADE with "
                            f"{LAUNCHER} (built by ./run.sh setup) instead of yade, or use backend = 'python'")
+    import yade.wrapper
+
+    if not getattr(yade.wrapper, LAW2).asPlugin():
+        return  # compiled into a YADE built from source (yade_law/README.md): YADE's own headers
     verdict = layout_check().verdict(os.environ.get("YADE_PREFIX", ""))
     if verdict:
         raise RuntimeError(verdict)
