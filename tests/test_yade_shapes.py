@@ -10,6 +10,7 @@
 2. What the law cannot handle is refused at the first step, naming it.
 3. Three of the examples Debian's YADE ships, with the law swapped in at test time.
 """
+import functools
 import json
 import math
 import re
@@ -309,10 +310,12 @@ def test_what_the_law_cannot_handle_is_refused_naming_it(case, words):
 
 
 # ---------------------------------------------------------------- YADE's shipped examples
-def derive(example, replacements, steps, law, checks, before=r"NewtonIntegrator\("):
+def derive_example(example, replacements, steps, law, checks, before=r"NewtonIntegrator\(", backend="python"):
     """The installed example with the law swapped in: its text with `replacements`
     (regex, replacement) applied, the GUI left out, the law's runner put before
-    NewtonIntegrator, then `steps` steps and a report of what the test checks."""
+    NewtonIntegrator (backend "cpp": the example's engine list given to insert_stickslip, as
+    a user of the compiled law would), then `steps` steps and a report of what the test
+    checks."""
     text = (EXAMPLES / example).read_text()
     text = re.sub(r"^.*\bqt\b.*$", "", text, flags=re.M)  # no GUI (qt.View, qt.Renderer, imports)
     text = re.sub(r"^from __future__ import .*$", "", text, flags=re.M)  # Python 3 has them all
@@ -320,20 +323,22 @@ def derive(example, replacements, steps, law, checks, before=r"NewtonIntegrator\
     for pattern, repl in replacements:
         text, n = re.subn(pattern, repl, text, flags=re.M)
         assert n, f"{example}: {pattern!r} not found: the example changed"
-    text, n = re.subn(f"({before})", f"stickslip_runner({law}), \\1", text, flags=re.M)
-    assert n == 1, f"{example}: one NewtonIntegrator expected in O.engines"
+    if backend == "python":
+        text, n = re.subn(f"({before})", f"stickslip_runner({law}), \\1", text, flags=re.M)
+        assert n == 1, f"{example}: one NewtonIntegrator expected in O.engines"
     head = (f"import sys, json\nsys.path.insert(0, {str(LAW)!r})\n"
-            f"from stickslip_yade import stickslip_runner, stickslip_material\n")
-    tail = f"""
+            f"from stickslip_yade import stickslip_runner, stickslip_material, insert_stickslip\n")
+    swap = f"O.engines = insert_stickslip(O.engines, {law}, backend='cpp')\n" if backend == "cpp" else ""
+    tail = swap + f"""
 import math as _m, builtins as _b  # (examples do `from numpy import *`, which shadows sum and all)
 _n = len(O.bodies)
 _e0 = _b.sum(b.state.mass * 10.0 * (b.state.pos[{checks['up']}] - {checks['bottom']}) for b in O.bodies if b.dynamic)
 _ek, _most, _slips = [], 0, 0
 for _k in range({steps}):
     O.step()
-    _most = max(_most, stickslip_law.n_contacts())
-    _slips += int(stickslip_law.slipped.sum())
+    _slips += int(stickslip_law.n_slipped)  # (contacts that slipped in the step)
     if _k % 50 == 0:
+        _most = max(_most, stickslip_law.n_contacts())
         _ek.append(_b.sum(0.5 * b.state.mass * b.state.vel.squaredNorm() for b in O.bodies if b.dynamic))
 _pos = [list(b.state.pos) for b in O.bodies if b is not None and b.dynamic and not b.isClump]
 print("RESULT " + json.dumps({{"n0": _n, "n": len([b for b in O.bodies if b is not None]), "pos": _pos,
@@ -343,10 +348,12 @@ print("RESULT " + json.dumps({{"n0": _n, "n": len([b for b in O.bodies if b is n
     return head + text + tail
 
 
-@pytest.mark.parametrize("example", ["baraban", "clump-inbox",  # 7 s, 4 s
-                                     pytest.param("periodicSandPile", marks=pytest.mark.slow)])  # 20 s
-def test_shipped_examples_run_with_the_law(tmp_path, example):
-    """Variants of three of Debian's YADE examples: a drum of facets turned by a
+@pytest.mark.parametrize("backend", ["python", "cpp"])
+@pytest.mark.parametrize("example", ["baraban", "clump-inbox",  # 9 s, 5 s on the Python law; 3 s, 1 s compiled
+                                     pytest.param("periodicSandPile", marks=pytest.mark.slow)])  # 35 s, 13 s
+def test_shipped_examples_run_with_the_law(tmp_path, example, backend):
+    """Variants of three of Debian's YADE examples, on the Python law and on the compiled
+    one (the example's own engine list through insert_stickslip): a drum of facets turned by a
     RotationEngine (baraban/baraban.py), clumps and spheres falling into a facet box
     (clumps/clump-inbox-viscoelastic.py), spheres piling up on a box in a periodic cell, with
     contacts across the boundary (PeriodicBoundaries/periodicSandPile.py). The ViscEl
@@ -362,6 +369,11 @@ def test_shipped_examples_run_with_the_law(tmp_path, example):
     fall to the container's bottom."""
     if not EXAMPLES.is_dir():
         skip_engine("yade", "YADE's examples are not installed (/usr/share/doc/yade/examples)")
+    launcher = "yade"
+    if backend == "cpp":  # the compiled law: YADE started by its launcher
+        skip_engine("yade_cpp")
+        from stickslip.adapters.yade_cpp import LAUNCHER as launcher
+    derive = functools.partial(derive_example, backend=backend)
     mu35 = math.tan(math.radians(35))
     law = f"ks=5e5, nu_s=0.0, mu_s={mu35:.6f}, mu_k={0.9 * mu35:.6f}"
     if example == "baraban":
@@ -391,7 +403,7 @@ def test_shipped_examples_run_with_the_law(tmp_path, example):
         inside = lambda p: p[1] % 1.8 >= 0.6 - 0.01  # noqa: E731
     script = tmp_path / "variant.py"
     script.write_text(text)
-    r = yade(tmp_path, script, timeout=1200)
+    r = yade(tmp_path, script, timeout=1200, launcher=launcher)
     assert r["n"] == r["n0"] and r["finite"] and all(inside(p) for p in r["pos"])
     assert r["contacts"] > 10 and r["slips"] > 100
     assert max(r["ek"]) <= r["e0"] + r["ek"][0]
