@@ -182,6 +182,8 @@ FACTS = [
          (r"(\d+ of \d+) \(LAMMPS 2021's styles\)",)),
     Fact("the sub-model's mutants killed", "docs/testing.md, its score", lambda: score("### The sub-model on LAMMPS"),
          (r"(\d+ of \d+) \(LAMMPS' sub-model\)",)),
+    Fact("YADE's compiled law's mutants killed", "docs/testing.md, its score",
+         lambda: score("### The compiled law on YADE"), (r"(\d+ of \d+) \(YADE's compiled law\)",)),
     Fact("DEM-Engine's mutants killed", "docs/testing.md, its score",
          lambda: score("### The force model on DEM-Engine"), (r"(\d+ of \d+) \(DEM-Engine\)",)),
     Fact("DEM-Engine's mutants", "tools/mutate_cpp.py, DEME_MUTANTS", lambda: str(len(mutants("DEME_MUTANTS"))),
@@ -254,7 +256,8 @@ def test_the_mutation_scores_count_the_tools_mutants():
     """docs/testing.md's score of each engine counts the mutants tools/mutate_cpp.py makes."""
     for heading, name in (("### The C++ law on LIGGGHTS", "LIGGGHTS_MUTANTS"), ("### The C++ law on LAMMPS",
                           "LAMMPS_MUTANTS"), ("### The sub-model on LAMMPS", "LAMMPS_GRANULAR_MUTANTS"),
-                          ("### The force model on DEM-Engine", "DEME_MUTANTS")):
+                          ("### The force model on DEM-Engine", "DEME_MUTANTS"),
+                          ("### The compiled law on YADE", "YADE_CPP_MUTANTS")):
         assert score(heading).split(" of ")[1] == str(len(mutants(name))), heading
 
 
