@@ -120,10 +120,10 @@ setup_yade_law() {
     # of core/, lib/ and pkg/ are kept, build/yade_source/), the plugin compiled with the
     # definitions read from the installed YADE (yade_flags.py), a private YADE prefix
     # (build/yade_law/prefix) and the launcher build/yade_law/yade-stickslip, which checks the
-    # plugin against the installed YADE (layout_check.py) and starts YADE with it. ~4 min on 2
+    # plugin against the installed YADE (layout_check.py) and starts YADE with it. ~2.5 min on 2
     # cores the first time; cmake rebuilds only what changed. Also a second plugin built for a
     # YADE without MPI (build/yade_law_wrong), which the layout check must refuse
-    # (tests/test_yade_compiled.py), ~4 min once.
+    # (tests/test_yade_compiled.py), included in that time.
     command -v yade >/dev/null 2>&1 || return 0
     install_packages libeigen3-dev libboost-python-dev libboost-serialization-dev libboost-log-dev \
         libboost-thread-dev libcgal-dev python3-dev || return 0
@@ -368,7 +368,7 @@ setup_liggghts_public() {
     local core=law_core/stick_slip_core.h
     src=$top/source/src
     if [ ! -f "$top/source/.complete" ]; then
-        echo "setup: LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (first time: ~10 min on 2 cores)"
+        echo "setup: LIGGGHTS-PUBLIC 3.8.0 from Debian 12's source (first time: ~5 min on 2 cores)"
         fetch_debian_source bookworm liggghts "$version" "$top/download"
         rm -rf "$top/source" && mkdir -p "$top/source"
         tar -xJf "$top"/download/liggghts_*.orig.tar.xz -C "$top/source" --strip-components=1 \
