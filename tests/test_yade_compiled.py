@@ -367,8 +367,8 @@ def test_drop_in_scenes_equal_the_python_law(scene):
     """Sphere pairs, a still, translating and turning facet, a pair across a periodic
     boundary (the cell still and sheared), a sphere on a facet through its image across a
     sheared cell's boundary, a clump on a facet (tests/test_yade_shapes.py), kinematics
-    imposed: the compiled
-    law's force on each contact at each step against the Python law's, in one YADE process.
+    imposed: the compiled law's force on each contact at each step against the Python law's,
+    in one YADE process.
     Both do the same operations in another order: each force may differ by a few roundings of
     mu*Fn per step, and the spring carries them on while the contact sticks (a slip puts both
     at Fmin): over the 700 steps at most 700 * 8 ulps of mu*Fn."""

@@ -10,7 +10,6 @@
 2. What the law cannot handle is refused at the first step, naming it.
 3. Three of the examples Debian's YADE ships, with the law swapped in at test time.
 """
-import functools
 import json
 import math
 import re
@@ -67,16 +66,11 @@ elif scene.startswith("facet"):
         plan = [(700, None)]
     elif scene == "facet_rolling":  # the sphere spinning about a tangent: its lever arm (midway in the overlap) counts
         O.bodies[moving].state.angVel = Vector3(0, 30.0, 0)
-elif scene == "periodic":  # two spheres touching across the x boundary of the cell
+elif scene in ("periodic", "periodic_sheared"):  # two spheres touching across the x boundary of the cell
     O.periodic = True
     O.cell.setBox(0.1, 0.1, 0.1)
-    held(utils.sphere((0.005, 0.05, 0.05), R, material=mat))
-    moving = held(utils.sphere((0.1 - 0.015 + DELTA, 0.05, 0.05), R, material=mat))
-    plan = [(300, (0.0, 0.02, -0.01)), (400, (0.0, -0.02, 0.005))]
-elif scene == "periodic_sheared":  # the same pair in a sheared cell (v_y = 0.2 x): its image moves
-    O.periodic = True
-    O.cell.setBox(0.1, 0.1, 0.1)
-    O.cell.velGrad = Matrix3(0, 0, 0, 0.2, 0, 0, 0, 0, 0)
+    if scene == "periodic_sheared":  # the cell sheared (v_y = 0.2 x): the image moves
+        O.cell.velGrad = Matrix3(0, 0, 0, 0.2, 0, 0, 0, 0, 0)
     held(utils.sphere((0.005, 0.05, 0.05), R, material=mat))
     moving = held(utils.sphere((0.1 - 0.015 + DELTA, 0.05, 0.05), R, material=mat))
     plan = [(300, (0.0, 0.02, -0.01)), (400, (0.0, -0.02, 0.005))]
@@ -310,7 +304,7 @@ def test_what_the_law_cannot_handle_is_refused_naming_it(case, words):
 
 
 # ---------------------------------------------------------------- YADE's shipped examples
-def derive_example(example, replacements, steps, law, checks, before=r"NewtonIntegrator\(", backend="python"):
+def derive(example, replacements, steps, law, checks, before=r"NewtonIntegrator\(", backend="python"):
     """The installed example with the law swapped in: its text with `replacements`
     (regex, replacement) applied, the GUI left out, the law's runner put before
     NewtonIntegrator (backend "cpp": the example's engine list given to insert_stickslip, as
@@ -373,17 +367,17 @@ def test_shipped_examples_run_with_the_law(tmp_path, example, backend):
     if backend == "cpp":  # the compiled law: YADE started by its launcher
         skip_engine("yade_cpp")
         from stickslip.adapters.yade_cpp import LAUNCHER as launcher
-    derive = functools.partial(derive_example, backend=backend)
     mu35 = math.tan(math.radians(35))
     law = f"ks=5e5, nu_s=0.0, mu_s={mu35:.6f}, mu_k={0.9 * mu35:.6f}"
     if example == "baraban":
         stl = EXAMPLES / "baraban" / "baraban.stl"
         text = derive("baraban/baraban.py", [(r"frictionAngle=frictionAngle", "frictionAngle=0"),
-                                             (r"'baraban\.stl'", repr(str(stl)))], 5000, law, {"up": 1, "bottom": -5.0})
+                                             (r"'baraban\.stl'", repr(str(stl)))], 5000, law, {"up": 1, "bottom": -5.0},
+                      backend=backend)
         inside = lambda p: math.hypot(p[0], p[1]) <= 5.03  # noqa: E731 -- the drum's facets reach 5.02 m from its axis
     elif example == "clump-inbox":
         text = derive("clumps/clump-inbox-viscoelastic.py", [(r"frictionAngle=frictionAngle", "frictionAngle=0")],
-                      16000, law, {"up": 2, "bottom": -1.0})
+                      16000, law, {"up": 2, "bottom": -1.0}, backend=backend)
         inside = lambda p: max(abs(p[0]), abs(p[1])) <= 1.0 and p[2] >= -1.0  # noqa: E731 -- the box, open on top
     else:
         mu30 = math.tan(math.radians(30))
@@ -397,7 +391,7 @@ def test_shipped_examples_run_with_the_law(tmp_path, example, backend):
             (r"^\s*GlobalStiffnessTimeStepper\(.*$", ""),
             (r"^O\.dt = 0\.2 \* PWaveTimeStep\(\)", "O.dt = 4e-4"),
         ], 3000, f"ks=25.0, nu_s=0.0, mu_s={mu30:.6f}, mu_k={0.9 * mu30:.6f}", {"up": 1, "bottom": 0.6},
-            before=r"^\s*newton\s*$")
+            before=r"^\s*newton\s*$", backend=backend)
         # On the box, in the cell: x, z are periodic (any value); y too, with period 3*0.6 m
         # (a few spheres end one period down, also in the native example: 6 of 2000).
         inside = lambda p: p[1] % 1.8 >= 0.6 - 0.01  # noqa: E731
